@@ -1,0 +1,5 @@
+#pragma once
+
+// Every shape of the geometry kernel, for code that wants them all (the scene loader, tests).
+#include "csgrt/core/instance.h"
+#include "csgrt/core/sphere.h"

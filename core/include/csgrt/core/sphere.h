@@ -1,0 +1,38 @@
+#pragma once
+
+#include "csgrt/core/shape.h"
+
+namespace csgrt {
+
+/// The solid ball |p - center| <= radius.
+///
+/// Parameterisation (as in Suffern, "Ray Tracing from the Ground Up", with y up): azimuth
+/// phi = atan2(x, z) in [0, 2 pi), polar angle theta = acos(y / r) in [0, pi] from +y;
+/// uv = (phi / 2 pi, 1 - theta / pi).
+class Sphere final : public Shape {
+public:
+    /// Throws InvalidParameter unless center is finite and radius > 0 and finite.
+    Sphere(const Point3& center, double radius);
+
+    std::string_view kind() const override { return "sphere"; }
+    Aabb bounds() const override;
+    bool is_solid() const override { return true; }
+
+    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
+    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
+    void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
+    bool contains(const Point3& p) const override;
+    Hit finish(const Ray& ray, const HitRecord& record) const override;
+
+    const Point3& center() const { return center_; }
+    double radius() const { return radius_; }
+
+    /// Both roots t0 <= t1 of the ray's line with the sphere, or false when it misses.
+    bool line_roots(const Ray& ray, double& t0, double& t1) const;
+
+private:
+    Point3 center_;
+    double radius_;
+};
+
+}  // namespace csgrt

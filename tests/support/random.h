@@ -1,0 +1,61 @@
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+
+#include "csgrt/core/aabb.h"
+#include "csgrt/core/math.h"
+#include "csgrt/core/ray.h"
+
+namespace csgrt::test {
+
+/// Seeded random numbers for property tests: a failure reproduces from the seed it prints.
+class Random {
+public:
+    explicit Random(std::uint64_t seed) : engine_(seed) {}
+
+    double uniform(double lo = 0.0, double hi = 1.0) {
+        return std::uniform_real_distribution<double>(lo, hi)(engine_);
+    }
+    int integer(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(engine_); }
+
+    /// Uniform on the unit sphere (Marsaglia's normal-deviate method).
+    Vector3 unit_vector() {
+        std::normal_distribution<double> normal;
+        Vector3 v;
+        do {
+            v = Vector3(normal(engine_), normal(engine_), normal(engine_));
+        } while (v.squaredNorm() < 1e-12);
+        return v.normalized();
+    }
+
+    Point3 in_box(const Aabb& box) {
+        return Point3(uniform(box.lower.x(), box.upper.x()), uniform(box.lower.y(), box.upper.y()),
+                      uniform(box.lower.z(), box.upper.z()));
+    }
+
+    /// A ray from a random point of `from` toward a random point of `toward`, with a direction
+    /// of random length in [0.25, 4] so nothing relies on unit directions.
+    Ray ray_between(const Aabb& from, const Aabb& toward) {
+        Ray ray;
+        ray.origin = in_box(from);
+        Vector3 direction = in_box(toward) - ray.origin;
+        if (direction.squaredNorm() == 0.0) direction = unit_vector();
+        ray.direction = direction.normalized() * uniform(0.25, 4.0);
+        return ray;
+    }
+
+    std::mt19937_64& engine() { return engine_; }
+
+private:
+    std::mt19937_64 engine_;
+};
+
+/// `box` grown by `factor` times its diagonal on every side.
+inline Aabb enlarged(const Aabb& box, double factor) {
+    const Vector3 margin = box.diagonal() * factor;
+    return Aabb(box.lower - margin, box.upper + margin);
+}
+
+}  // namespace csgrt::test
