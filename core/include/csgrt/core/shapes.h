@@ -2,4 +2,6 @@
 
 // Every shape of the geometry kernel, for code that wants them all (the scene loader, tests).
 #include "csgrt/core/instance.h"
+#include "csgrt/core/part_torus.h"
 #include "csgrt/core/sphere.h"
+#include "csgrt/core/torus.h"
