@@ -13,17 +13,6 @@ constexpr Real rounding_bound(int n) {
     return n * u / (1 - n * u);
 }
 
-// p(x) and p'(x) by Horner's rule; coefficients in ascending powers.
-template <class Real, int Degree>
-void evaluate(const Real* c, Real x, Real& value, Real& slope) {
-    value = c[Degree];
-    slope = 0;
-    for (int i = Degree - 1; i >= 0; --i) {
-        slope = slope * x + value;
-        value = value * x + c[i];
-    }
-}
-
 // sum_i |w_i| |x|^i. With w = c it is the scale of the rounding error of Horner's rule,
 // |error| <= gamma(2 n) sum |c_i| |x|^i (Higham, "Accuracy and Stability of Numerical
 // Algorithms", 2002, 5.1).
@@ -35,32 +24,51 @@ Real magnitude(const Real* w, Real x) {
     return sum;
 }
 
-template <class Real>
-Real nth_root(Real x, int n) {
-    switch (n) {
-        case 1:
-            return x;
-        case 2:
-            return std::sqrt(x);
-        case 3:
-            return std::cbrt(x);
-        default:
-            return std::sqrt(std::sqrt(x));
+// p(x) and p'(x) by Horner's rule (coefficients in ascending powers), with the bound
+// gamma(2 n) sum |c_i| |x|^i on the rounding error of p(x).
+template <class Real, int Degree>
+void evaluate(const Real* c, Real x, Real& value, Real& slope, Real& error) {
+    const Real ax = std::abs(x);
+    value = c[Degree];
+    slope = 0;
+    Real scale = std::abs(c[Degree]);
+    for (int i = Degree - 1; i >= 0; --i) {
+        slope = slope * x + value;
+        value = value * x + c[i];
+        scale = scale * ax + std::abs(c[i]);
     }
+    error = rounding_bound<Real>(2 * Degree) * scale;
+}
+
+template <class Real, int Degree>
+void evaluate(const Real* c, Real x, Real& value, Real& slope) {
+    Real error;
+    evaluate<Real, Degree>(c, x, value, slope, error);
+}
+
+// The smallest power of two at or above x^(1/k): cheaper than the root, at most 2x larger.
+template <class Real>
+Real power_of_two_root(Real x, int k) {
+    if (x == 0) return 0;
+    int exponent;
+    std::frexp(x, &exponent);  // x < 2^exponent
+    const int root_exponent = exponent >= 0 ? (exponent + k - 1) / k : -(-exponent / k);
+    return std::ldexp(Real(1), root_exponent);
 }
 
 // Fujiwara's bound (1916): every complex root z of sum c_i z^i has
-// |z| <= 2 max_k |c_{n-k} / c_n|^(1/k), with c_0 halved. Widened a little against rounding.
+// |z| <= 2 max_k |c_{n-k} / c_n|^(1/k), with c_0 halved; each k-th root is rounded up to a
+// power of two.
 template <class Real, int Degree>
 Real root_bound(const Real* c) {
     Real bound = 0;
     for (int k = 1; k <= Degree; ++k) {
         Real ratio = std::abs(c[Degree - k] / c[Degree]);
         if (k == Degree) ratio /= 2;
-        bound = std::max(bound, nth_root(ratio, k));
+        bound = std::max(bound, power_of_two_root(ratio, k));
     }
     // A positive bound even for c_n t^n, so its root 0 gets neighbours to be judged against.
-    return bound > 0 ? Real(2.125) * bound : Real(1);
+    return bound > 0 ? 2 * bound : Real(1);
 }
 
 template <class Real>
@@ -70,9 +78,13 @@ int sign_of(Real value) {
 
 // The real roots of sum c_i t^i (ascending) in [lo, hi], counted as documented for
 // solve_quartic. Each degree isolates its roots between the roots of its derivative, found by
-// the degree below; the quadratic is solved in closed form.
+// the degree below on the same interval; the quadratic is solved in closed form. `clamp`
+// narrows [lo, hi] to the root bound first, which keeps brackets (and Newton's far-field
+// phase, where it gains only a factor (n - 1) / n per step) short; the derivative needs no
+// clamping, as its roots lie within the hull of the polynomial's (Gauss-Lucas).
 template <class Real, int Degree>
-int roots_in_interval(const Real* c, const Real* errors, Real lo, Real hi, Real* roots) {
+int roots_in_interval(const Real* c, const Real* errors, Real lo, Real hi, Real* roots,
+                      bool clamp) {
     if constexpr (Degree <= 2) {
         Real pair[2];
         const int found = detail::solve_quadratic(c[2], c[1], c[0], pair);
@@ -82,13 +94,14 @@ int roots_in_interval(const Real* c, const Real* errors, Real lo, Real hi, Real*
         }
         return count;
     } else {
-        if (c[Degree] == 0) return roots_in_interval<Real, Degree - 1>(c, errors, lo, hi, roots);
-        if (!(lo <= hi)) return 0;
-        // Every root lies within the bound: clamping keeps brackets (and Newton's far-field
-        // phase, where it gains only a factor (n - 1) / n per step) short.
-        const Real bound = root_bound<Real, Degree>(c);
-        lo = std::max(lo, -bound);
-        hi = std::min(hi, bound);
+        if (c[Degree] == 0) {
+            return roots_in_interval<Real, Degree - 1>(c, errors, lo, hi, roots, clamp);
+        }
+        if (clamp) {
+            const Real bound = root_bound<Real, Degree>(c);
+            lo = std::max(lo, -bound);
+            hi = std::min(hi, bound);
+        }
         if (!(lo <= hi)) return 0;
 
         // p is monotone between consecutive roots of p' (the extrema).
@@ -96,7 +109,7 @@ int roots_in_interval(const Real* c, const Real* errors, Real lo, Real hi, Real*
         for (int i = 0; i < Degree; ++i) derivative[i] = Real(i + 1) * c[i + 1];
         Real extrema[Degree - 1];
         const int extremum_count =
-            roots_in_interval<Real, Degree - 1>(derivative, nullptr, lo, hi, extrema);
+            roots_in_interval<Real, Degree - 1>(derivative, nullptr, lo, hi, extrema, false);
 
         Real knots[Degree + 1];
         Real values[Degree + 1];
@@ -126,8 +139,8 @@ int roots_in_interval(const Real* c, const Real* errors, Real lo, Real hi, Real*
             }
         }
 
-        auto polynomial = [c](Real x, Real& value, Real& slope) {
-            evaluate<Real, Degree>(c, x, value, slope);
+        auto polynomial = [c](Real x, Real& value, Real& slope, Real& error) {
+            evaluate<Real, Degree>(c, x, value, slope, error);
         };
         int count = 0;
         int k = 0;
@@ -178,14 +191,14 @@ int solve_cubic_any(Real a, Real b, Real c, Real d, Real roots[3]) {
     const Real coeffs[4] = {d, c, b, a};
     if (!all_finite<Real, 3>(coeffs)) return 0;
     const Real infinity = std::numeric_limits<Real>::infinity();
-    return roots_in_interval<Real, 3>(coeffs, nullptr, -infinity, infinity, roots);
+    return roots_in_interval<Real, 3>(coeffs, nullptr, -infinity, infinity, roots, true);
 }
 
 template <class Real>
 int solve_quartic_bracketing(const Real coeffs[5], const Real* errors, Real t_lo, Real t_hi,
                              Real roots[4]) {
     if (!all_finite<Real, 4>(coeffs) || std::isnan(t_lo) || std::isnan(t_hi)) return 0;
-    return roots_in_interval<Real, 4>(coeffs, errors, t_lo, t_hi, roots);
+    return roots_in_interval<Real, 4>(coeffs, errors, t_lo, t_hi, roots, true);
 }
 
 // Ferrari's method in Descartes' form: depress t = y - a/4 to y^4 + P y^2 + Q y + R, factor
@@ -269,7 +282,7 @@ int solve_cubic(long double a, long double b, long double c, long double d, long
 
 int solve_cubic(const double coeffs[4], double t_lo, double t_hi, double roots[3]) {
     if (!all_finite<double, 3>(coeffs) || std::isnan(t_lo) || std::isnan(t_hi)) return 0;
-    return roots_in_interval<double, 3>(coeffs, nullptr, t_lo, t_hi, roots);
+    return roots_in_interval<double, 3>(coeffs, nullptr, t_lo, t_hi, roots, true);
 }
 
 int solve_quartic(const double coeffs[5], double t_lo, double t_hi, double roots[4],

@@ -28,37 +28,32 @@ struct TubeAlongRay {
     double major_radius;
     double minor_radius;
 
-    void operator()(double t, double& value, double& slope) const {
+    // h(t), h'(t), and a bound on the rounding error of h(t): the point o + t d is off the
+    // line by up to e = 2 u (|o| + |t| |d|) per coordinate; rho then by e + 2 u (rho + R)
+    // after subtracting R; squaring doubles the relative error, and the sum adds a few u of
+    // its terms. Near the surface (|rho - R|, |y| <= r) that is ~ 4 r (e + 2 u R): a few ulps
+    // of the coordinates, times r.
+    void operator()(double t, double& value, double& slope, double& error) const {
         const Point3 p = origin + t * direction;
         const double rho = std::sqrt(p.x() * p.x() + p.z() * p.z());
         const double radial = rho - major_radius;
-        value = radial * radial + p.y() * p.y() - minor_radius * minor_radius;
+        const double height = p.y();
+        value = radial * radial + height * height - minor_radius * minor_radius;
         // d rho / dt is undefined on the axis, where the surface is not (r < R).
         const double rho_slope =
             rho > 0.0 ? (p.x() * direction.x() + p.z() * direction.z()) / rho : 0.0;
-        slope = 2.0 * (radial * rho_slope + p.y() * direction.y());
+        slope = 2.0 * (radial * rho_slope + height * direction.y());
+        const double point_error =
+            2.0 * kUnitRoundoff * (origin.norm() + std::abs(t) * direction.norm());
+        const double radial_error = point_error + 2.0 * kUnitRoundoff * (rho + major_radius);
+        error = 2.0 * (std::abs(radial) * radial_error + std::abs(height) * point_error) +
+                4.0 * kUnitRoundoff * (radial * radial + height * height + square(minor_radius));
     }
 
     double value(double t) const {
-        double value, slope;
-        (*this)(t, value, slope);
+        double value, slope, error;
+        (*this)(t, value, slope, error);
         return value;
-    }
-
-    // A bound on the rounding error of value(t): the point o + t d is off the line by up to
-    // e = 2 u (|o| + |t| |d|) per coordinate; rho then by e + 2 u rho; rho - R by that plus
-    // u |rho - R|; squaring doubles the relative error. With |rho - R|, |y| ~ r near the
-    // surface the bound is ~ 4 r (e + 3 u R): a few ulps of the coordinates, times r.
-    double error(double t) const {
-        const Point3 p = origin + t * direction;
-        const double rho = std::sqrt(p.x() * p.x() + p.z() * p.z());
-        const double radial = std::abs(rho - major_radius);
-        const double point_error =
-            2.0 * kUnitRoundoff * (origin.norm() + std::abs(t) * direction.norm());
-        const double rho_error = point_error + 2.0 * kUnitRoundoff * (rho + major_radius);
-        return 2.0 *
-               (2.0 * (radial * rho_error + std::abs(p.y()) * point_error) +
-                4.0 * kUnitRoundoff * (radial * radial + p.y() * p.y() + square(minor_radius)));
     }
 };
 
@@ -152,8 +147,9 @@ int Torus::line_roots(const Ray& ray, double roots[4]) const {
             // says whether the line misses, touches, or crosses twice.
             const double touch = roots[i];
             const double after = i + 2 < count ? 0.5 * (touch + roots[i + 2]) : t_exit;
-            const double depth = side * tube.value(touch);
-            const double noise = tube.error(touch);
+            double value, slope, noise;
+            tube(touch, value, slope, noise);
+            const double depth = side * value;
             if (depth > noise) {
                 i += 2;  // the line passes by without reaching the surface
                 continue;

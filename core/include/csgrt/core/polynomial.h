@@ -37,13 +37,16 @@ int solve_quadratic(Real a, Real b, Real c, Real roots[2]) {
 
 /// A root of a continuous function f in [lo, hi], given that f(lo) and f(hi) are nonzero with
 /// opposite signs (`negative_at_lo` says which), starting from `start` in [lo, hi].
-/// `evaluate(x, value, slope)` gives f(x) and f'(x). Safeguarded Newton as in "rtsafe" (Press
-/// et al., "Numerical Recipes", 3rd ed., 9.4): a Newton step is taken only when it stays inside
-/// the bracket and at least halves the step before the last one, otherwise the bracket is
-/// bisected, and every evaluation shrinks the bracket by its sign. So it always converges
-/// (at worst linearly), quadratically near a simple root, and never leaves the bracket. Stops
-/// when a step falls below 2 ulps of x, f is exactly 0, or after 200 evaluations (bisection
-/// alone gains a bit per evaluation, so this only cuts off brackets spanning ~1e60).
+/// `evaluate(x, value, slope, error)` gives f(x), f'(x) and a bound on the rounding error of
+/// the computed f(x). Safeguarded Newton as in "rtsafe" (Press et al., "Numerical Recipes",
+/// 3rd ed., 9.4): a Newton step is taken only when it stays inside the bracket and at least
+/// halves the step before the last one, otherwise the bracket is bisected, and every
+/// evaluation shrinks the bracket by its sign. So it always converges (at worst linearly),
+/// quadratically near a simple root, and never leaves the bracket. Stops as soon as |f(x)| is
+/// within its rounding error (x is then as close to the root as f's precision can tell; one
+/// last Newton step from there is free), when
+/// a step falls below 2 ulps of x, or after 200 evaluations (bisection alone gains a bit per
+/// evaluation, so this only cuts off brackets spanning ~1e60).
 template <class Real, class Evaluate>
 Real bracketed_root(const Evaluate& evaluate, Real lo, Real hi, bool negative_at_lo, Real start) {
     constexpr Real kUlps = 2 * std::numeric_limits<Real>::epsilon();
@@ -51,15 +54,19 @@ Real bracketed_root(const Evaluate& evaluate, Real lo, Real hi, bool negative_at
     Real step = hi - lo;
     Real step_before = step;
     for (int iteration = 0; iteration < 200; ++iteration) {
-        Real value, slope;
-        evaluate(x, value, slope);
-        if (value == 0) return x;
+        Real value, slope, error;
+        evaluate(x, value, slope, error);
+        const Real newton = x - value / slope;
+        if (std::abs(value) <= error) {
+            // The last step costs no evaluation and, as the error bound is pessimistic,
+            // usually still gains digits.
+            return newton >= lo && newton <= hi ? newton : x;
+        }
         if ((value < 0) == negative_at_lo) {
             lo = x;
         } else {
             hi = x;
         }
-        const Real newton = x - value / slope;
         Real next;
         if (newton > lo && newton < hi && std::abs(newton - x) <= Real(0.5) * step_before) {
             next = newton;
