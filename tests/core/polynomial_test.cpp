@@ -286,7 +286,7 @@ TEST(SolveCubic, AnalyticRootsAndDegenerateCases) {
     ASSERT_EQ(solve_cubic(1, -4, 5, -2, roots), 3);  // (t-1)^2 (t-2): the double root twice
     EXPECT_EQ(roots[0], 1.0);
     EXPECT_EQ(roots[1], 1.0);
-    EXPECT_NEAR(roots[2], 2.0, 2.8e-14);  // M(2) = 36, p'(2) = 1
+    EXPECT_NEAR(roots[2], 2.0, 2.8e-14);             // M(2) = 36, p'(2) = 1
     ASSERT_EQ(solve_cubic(1, -3, 3, -1, roots), 1);  // (t-1)^3 crosses zero: once
     EXPECT_NEAR(roots[0], 1.0, 1e-5);                // a triple root is known to cbrt(u)
     ASSERT_EQ(solve_cubic(1, 0, 0, 0, roots), 1);

@@ -287,5 +287,291 @@ TEST(Torus, PropertiesOnRandomRays) {
     }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Accuracy against a long double reference, written here independently of torus.cpp: the
+// quartic of the same (double) ray, built in long double around the point of the line nearest
+// the centre, solved by the long double solve_quartic on the chord of the sphere of radius
+// R + 2 r, each root then polished by Newton on the tube function in long double along the
+// original ray. Its error (u = 2^-64) is negligible next to double's.
+// ---------------------------------------------------------------------------------------------
+
+struct ReferenceRoot {
+    Long t;
+    Long cosine;  // |cos| of the angle between the ray and the surface normal
+};
+
+struct Reference {
+    std::vector<ReferenceRoot> roots;
+    // The extremum of the quartic along the line (a near-tangency) where the line comes
+    // closest to the surface: its distance to the surface, and its t.
+    Long closest_approach = kInfinity;
+    Long closest_t = 0;
+};
+
+Long tube_value(Long major, Long minor, const LongVector& p) {
+    const Long rho = std::sqrt(p.x() * p.x() + p.z() * p.z());
+    return (rho - major) * (rho - major) + p.y() * p.y() - minor * minor;
+}
+
+Long surface_distance(Long major, Long minor, const LongVector& p) {
+    const Long rho = std::sqrt(p.x() * p.x() + p.z() * p.z());
+    return std::sqrt((rho - major) * (rho - major) + p.y() * p.y()) - minor;
+}
+
+Reference reference_roots(double major_radius, double minor_radius, const Ray& ray) {
+    const Long major = major_radius;
+    const Long minor = minor_radius;
+    const LongVector o = ray.origin.cast<Long>();
+    const LongVector d = ray.direction.cast<Long>();
+    Reference reference;
+    const Long a = d.squaredNorm();
+    const Long t_center = -o.dot(d) / a;
+    const LongVector p = o + t_center * d;
+    const Long reach = major + 2 * minor;
+    if (p.squaredNorm() >= reach * reach) return reference;
+    const Long half_chord = std::sqrt((reach * reach - p.squaredNorm()) / a);
+    const Long b = p.dot(d);
+    const Long c = p.squaredNorm() + major * major - minor * minor;
+    const Long dxz = d.x() * d.x() + d.z() * d.z();
+    const Long exz = p.x() * d.x() + p.z() * d.z();
+    const Long fxz = p.x() * p.x() + p.z() * p.z();
+    const Long coeffs[5] = {c * c - 4 * major * major * fxz, 4 * b * c - 8 * major * major * exz,
+                            4 * b * b + 2 * a * c - 4 * major * major * dxz, 4 * a * b, a * a};
+    Long roots[4];
+    const int count = solve_quartic(coeffs, -half_chord, half_chord, roots);
+    for (int i = 0; i < count; ++i) {
+        Long t = t_center + roots[i];
+        const bool tangent =
+            (i > 0 && roots[i - 1] == roots[i]) || (i + 1 < count && roots[i + 1] == roots[i]);
+        for (int step = 0; step < 4 && !tangent; ++step) {
+            const LongVector q = o + t * d;
+            const Long rho = std::sqrt(q.x() * q.x() + q.z() * q.z());
+            const Long slope =
+                2 * ((rho - major) * (q.x() * d.x() + q.z() * d.z()) / rho + q.y() * d.y());
+            t -= tube_value(major, minor, q) / slope;
+        }
+        const LongVector q = o + t * d;
+        const Long rho = std::sqrt(q.x() * q.x() + q.z() * q.z());
+        LongVector normal(q.x() * (rho - major) / rho, q.y(), q.z() * (rho - major) / rho);
+        normal.normalize();
+        reference.roots.push_back({t, std::abs(normal.dot(d)) / std::sqrt(a)});
+    }
+    // Extrema of the quartic inside the chord: candidates for near-tangencies.
+    Long extrema[3];
+    const int extremum_count =
+        solve_cubic(4 * coeffs[4], 3 * coeffs[3], 2 * coeffs[2], coeffs[1], extrema);
+    for (int i = 0; i < extremum_count; ++i) {
+        if (std::abs(extrema[i]) > half_chord) continue;
+        const Long t = t_center + extrema[i];
+        const Long distance = std::abs(surface_distance(major, minor, o + t * d));
+        if (distance < reference.closest_approach) {
+            reference.closest_approach = distance;
+            reference.closest_t = t;
+        }
+    }
+    return reference;
+}
+
+// The same quartic built at the ray's own origin in double, solved and not polished: the
+// naive method, measured for docs/accuracy.md.
+std::vector<double> naive_roots(double major, double minor, const Ray& ray) {
+    const Vector3& o = ray.origin;
+    const Vector3& d = ray.direction;
+    const double a = d.squaredNorm(), b = o.dot(d),
+                 c = o.squaredNorm() + major * major - minor * minor;
+    const double dxz = d.x() * d.x() + d.z() * d.z();
+    const double exz = o.x() * d.x() + o.z() * d.z();
+    const double fxz = o.x() * o.x() + o.z() * o.z();
+    const double coeffs[5] = {c * c - 4 * major * major * fxz, 4 * b * c - 8 * major * major * exz,
+                              4 * b * b + 2 * a * c - 4 * major * major * dxz, 4 * a * b, a * a};
+    double roots[4];
+    const int count = solve_quartic(coeffs, -kInfinity, kInfinity, roots);
+    return std::vector<double>(roots, roots + count);
+}
+
+// The rounding scale of a point at parameter t: u (|o| + |t| |d| + R + r). Everything the
+// double computation can resolve is a small multiple of it.
+double point_scale(const Ray& ray, double t, double major, double minor) {
+    return kUnitRoundoff * (ray.origin.norm() + std::abs(t) * ray.direction.norm() + major + minor);
+}
+
+struct AccuracyStats {
+    int rays = 0;
+    int hit_rays = 0;
+    int roots = 0;
+    int ambiguous = 0;
+    int false_hits = 0;
+    int false_misses = 0;
+    double max_relative_error = 0;      // over roots with |cos| >= 0.1
+    double max_relative_error_all = 0;  // over all roots
+    double max_normalized_error = 0;    // error / derived bound
+    int naive_wrong_count = 0;
+    double naive_max_relative_error = 0;
+};
+
+// A ray from distance `distance` (in units of R + r) toward a random point within 1.5 r of
+// the core circle, so most rays hit even thin tori.
+Ray ray_toward_tube(test::Random& random, double major, double minor, double distance) {
+    const double phi = random.uniform(0, kTwoPi);
+    const Point3 core(major * std::sin(phi), 0, major * std::cos(phi));
+    const Point3 target = core + random.unit_vector() * (1.5 * minor * random.uniform());
+    const Point3 origin = random.unit_vector() * (distance * (major + minor));
+    return Ray{origin, (target - origin).normalized() * random.uniform(0.25, 4.0)};
+}
+
+// Compares line_roots with the reference on `rays` rays from `distance` radii away.
+// Derived bound on a root's error: the final polish stops where the tube function h is within
+// its rounding error, about 4 r (e + 2 u R) with e = 2 u (|o| + |t| |d|) (torus.cpp); h' = 2 r
+// |d| cos(angle), so |dt| <= (4 u (|o| + |t||d|) + 4 u R) / (|d| cos) <= 4 point_scale /
+// (|d| cos); we allow twice that plus 4 ulps of t (the reference's shift and the last step).
+// Rays whose reference line comes within 64 point_scale of tangency are ambiguous: the double
+// computation cannot tell a touch from a near miss there; they are counted, not judged.
+AccuracyStats measure_accuracy(double major, double minor, double distance, int rays,
+                               std::uint64_t seed) {
+    const Torus torus(major, minor);
+    test::Random random(seed);
+    AccuracyStats stats;
+    for (int i = 0; i < rays; ++i) {
+        const Ray ray = ray_toward_tube(random, major, minor, distance);
+        ++stats.rays;
+        const Reference reference = reference_roots(major, minor, ray);
+        const std::vector<double> found = all_roots(torus, ray);
+        if (reference.closest_approach <=
+            64 * point_scale(ray, static_cast<double>(reference.closest_t), major, minor)) {
+            ++stats.ambiguous;
+            continue;
+        }
+        if (found.size() > reference.roots.size()) ++stats.false_hits;
+        if (found.size() < reference.roots.size()) ++stats.false_misses;
+        EXPECT_EQ(found.size(), reference.roots.size())
+            << "ray " << i << " distance " << distance << " r " << minor;
+        if (found.size() != reference.roots.size()) continue;
+        if (!found.empty()) ++stats.hit_rays;
+        for (std::size_t k = 0; k < found.size(); ++k) {
+            const ReferenceRoot& expected = reference.roots[k];
+            const double t = static_cast<double>(expected.t);
+            const double error = static_cast<double>(std::abs(found[k] - expected.t));
+            const double bound = 8 * point_scale(ray, t, major, minor) /
+                                     (ray.direction.norm() * static_cast<double>(expected.cosine)) +
+                                 4 * kUnitRoundoff * std::abs(t);
+            EXPECT_LE(error, bound) << "ray " << i << " root " << k << " distance " << distance;
+            ++stats.roots;
+            const double relative = error / std::abs(t);
+            stats.max_relative_error_all = std::max(stats.max_relative_error_all, relative);
+            if (expected.cosine >= 0.1) {
+                stats.max_relative_error = std::max(stats.max_relative_error, relative);
+            }
+            stats.max_normalized_error = std::max(stats.max_normalized_error, error / bound);
+        }
+        const std::vector<double> naive = naive_roots(major, minor, ray);
+        if (naive.size() != found.size()) {
+            ++stats.naive_wrong_count;
+        } else {
+            for (std::size_t k = 0; k < naive.size(); ++k) {
+                const Long t = reference.roots[k].t;
+                stats.naive_max_relative_error =
+                    std::max(stats.naive_max_relative_error,
+                             static_cast<double>(std::abs(naive[k] - t) / t));
+            }
+        }
+    }
+    return stats;
+}
+
+TEST(TorusAccuracy, FarOriginsAgainstLongDoubleReference) {
+    // Printed figures are the ones in docs/accuracy.md.
+    std::cout << "  R     r      distance  rays  hit  roots ambiguous  max rel err (cos>=0.1)"
+                 "  max rel err (all)  worst/bound  | naive: wrong counts, max rel err\n";
+    std::uint64_t seed = 200;
+    for (const double minor : {0.25, 1e-3}) {
+        for (const double distance : {10.0, 1e3, 1e6}) {
+            const AccuracyStats stats = measure_accuracy(1.0, minor, distance, 20000, ++seed);
+            std::printf(
+                "  1  %6.0e  %8.0e  %5d %5d %6d %6d      %10.2e             %10.2e"
+                "         %5.3f  | %6d  %9.2e\n",
+                minor, distance, stats.rays, stats.hit_rays, stats.roots, stats.ambiguous,
+                stats.max_relative_error, stats.max_relative_error_all, stats.max_normalized_error,
+                stats.naive_wrong_count, stats.naive_max_relative_error);
+            EXPECT_EQ(stats.false_hits, 0);
+            EXPECT_EQ(stats.false_misses, 0);
+            EXPECT_GT(stats.hit_rays, 10000);
+            EXPECT_LT(stats.ambiguous, 20);
+            // For transversal hits (|cos| >= 0.1) the bound above is at most 80 u (|o| + |t d|
+            // + R + r) / (|t| |d|), about 200 u from afar: assert the measured figure.
+            EXPECT_LE(stats.max_relative_error, 200 * kUnitRoundoff);
+        }
+    }
+}
+
+TEST(TorusAccuracy, NearTangentRaysOutsideTheAmbiguityBand) {
+    // Rays tangent to the outer (convex) half of the tube at a point P, moved by delta along
+    // the normal: moved out they must not meet the surface near P, moved in they must cross it
+    // twice near P (the exact answer by construction). The double computation cannot resolve
+    // |delta| below a few point scales s = u (|o| + |t d| + R + r): the rounding of the ray's
+    // points themselves (torus.cpp decides near-tangencies on the tube function, whose noise
+    // is 2 s to 4 s in distance, and within it a near-tangency is reported as a touch).
+    // Asserted: no error for |delta| >= 8 s; measured: the error rate below that
+    // (docs/accuracy.md).
+    const double factors[] = {1e4, 1e3, 100, 32, 16, 8, 4, 2, 1, 0.5};
+    constexpr int kFactors = 10;
+    std::cout << "  r      distance  |delta|/s: ";
+    for (double f : factors) std::printf("%7g", f);
+    std::cout << "   (wrong answers out of 2 x 1000 rays each)\n";
+    test::Random random(300);
+    for (const double minor : {0.25, 1e-3}) {
+        const double major = 1.0;
+        const Torus torus(major, minor);
+        for (const double distance : {10.0, 1e3, 1e6}) {
+            int wrong[kFactors] = {};
+            for (int i = 0; i < 1000; ++i) {
+                const double phi = random.uniform(0, kTwoPi);
+                const double theta = random.uniform(-kPi / 3, kPi / 3);
+                const Vector3 radial(std::sin(phi), 0, std::cos(phi));
+                const Normal3 normal = std::cos(theta) * radial + Vector3(0, std::sin(theta), 0);
+                const Point3 on_surface = major * radial + minor * normal;
+                Vector3 tangent = random.unit_vector();
+                tangent = (tangent - tangent.dot(normal) * normal).normalized();
+                // Normal curvature along the tangent (both principal curvatures positive here).
+                const Vector3 along_tube(-std::sin(theta) * std::sin(phi), std::cos(theta),
+                                         -std::sin(theta) * std::cos(phi));
+                const double curvature =
+                    square(tangent.dot(along_tube)) / minor +
+                    square(tangent.dot(Vector3(std::cos(phi), 0, -std::sin(phi)))) *
+                        std::cos(theta) / (major + minor * std::cos(theta));
+                const double length = random.uniform(0.25, 4.0);
+                const double reach = distance * (major + minor);
+                const double t_touch = reach / length;
+                for (int f = 0; f < kFactors; ++f) {
+                    for (const double side : {1.0, -1.0}) {
+                        const double scale =
+                            kUnitRoundoff * (2 * reach + on_surface.norm() + major + minor);
+                        const double delta = side * factors[f] * scale;
+                        if (std::abs(delta) > 1e-3 * minor) continue;
+                        const Point3 touch = on_surface + delta * normal;
+                        const Ray ray{touch - reach * tangent, tangent * length};
+                        // Inward the line crosses at +-sqrt(2 |delta| / curvature) from P.
+                        const double window =
+                            (4 * std::sqrt(2 * std::abs(delta) / curvature) + 0.01 * minor) /
+                            length;
+                        int near = 0;
+                        for (double t : all_roots(torus, ray)) {
+                            if (std::abs(t - t_touch) <= window) ++near;
+                        }
+                        if (near != (side > 0 ? 0 : 2)) ++wrong[f];
+                        if (factors[f] >= 8) {
+                            EXPECT_EQ(near, side > 0 ? 0 : 2)
+                                << "r " << minor << " distance " << distance << " delta " << delta
+                                << " ray " << i;
+                        }
+                    }
+                }
+            }
+            std::printf("  %6.0e  %8.0e              ", minor, distance);
+            for (int f = 0; f < kFactors; ++f) std::printf("%7d", wrong[f]);
+            std::printf("\n");
+        }
+    }
+}
+
 }  // namespace
 }  // namespace csgrt
