@@ -1,8 +1,11 @@
 #include "csgrt/core/polynomial.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <type_traits>
 
 namespace csgrt {
 namespace {
@@ -46,13 +49,29 @@ void evaluate(const Real* c, Real x, Real& value, Real& slope) {
     evaluate<Real, Degree>(c, x, value, slope, error);
 }
 
-// The smallest power of two at or above x^(1/k): cheaper than the root, at most 2x larger.
+// The smallest power of two at or above x^(1/k), x >= 0: cheaper than the root, at most 2x
+// larger. For normal doubles the exponent is read and written directly (frexp and ldexp are
+// library calls that cost more than the rest of the bound).
 template <class Real>
 Real power_of_two_root(Real x, int k) {
-    if (x == 0) return 0;
-    int exponent;
-    std::frexp(x, &exponent);  // x < 2^exponent
+    if (x == 0 || !std::isfinite(x)) return x;
+    int exponent;  // x < 2^exponent
+    if constexpr (std::is_same_v<Real, double>) {
+        const int biased = static_cast<int>(std::bit_cast<std::uint64_t>(x) >> 52) & 0x7ff;
+        if (biased == 0) {
+            std::frexp(x, &exponent);  // subnormal
+        } else {
+            exponent = biased - 1022;
+        }
+    } else {
+        std::frexp(x, &exponent);
+    }
     const int root_exponent = exponent >= 0 ? (exponent + k - 1) / k : -(-exponent / k);
+    if constexpr (std::is_same_v<Real, double>) {
+        if (root_exponent > -1022 && root_exponent < 1024) {  // else ldexp's slow path
+            return std::bit_cast<double>(static_cast<std::uint64_t>(root_exponent + 1023) << 52);
+        }
+    }
     return std::ldexp(Real(1), root_exponent);
 }
 
@@ -201,6 +220,34 @@ int solve_quartic_bracketing(const Real coeffs[5], const Real* errors, Real t_lo
     return roots_in_interval<Real, 4>(coeffs, errors, t_lo, t_hi, roots, true);
 }
 
+// The largest real root of m^3 + b m^2 + c m + d = 0 in closed form (Cardano, in the
+// trigonometric form when there are three real roots), polished by one Newton step.
+double largest_cubic_root(double b, double c, double d) {
+    // m = y - b/3 gives y^3 + p y + q = 0.
+    const double shift = b / 3.0;
+    const double p = c - b * shift;
+    const double q = d - shift * (c - 2.0 / 9.0 * b * b);
+    const double half_q = 0.5 * q;
+    const double third_p = p / 3.0;
+    const double discriminant = half_q * half_q + third_p * third_p * third_p;
+    double y;
+    if (discriminant >= 0.0) {
+        // One real root: A + B with A B = -p/3, A taken without cancellation.
+        const double a =
+            -std::copysign(std::cbrt(std::abs(half_q) + std::sqrt(discriminant)), half_q);
+        y = a != 0.0 ? a - third_p / a : 0.0;
+    } else {
+        const double radius = std::sqrt(-third_p);
+        const double cosine = std::clamp(-half_q / (radius * radius * radius), -1.0, 1.0);
+        y = 2.0 * radius * std::cos(std::acos(cosine) / 3.0);
+    }
+    double m = y - shift;
+    const double value = ((m + b) * m + c) * m + d;
+    const double slope = (3.0 * m + 2.0 * b) * m + c;
+    if (slope != 0.0) m -= value / slope;
+    return m;
+}
+
 // Ferrari's method in Descartes' form: depress t = y - a/4 to y^4 + P y^2 + Q y + R, factor
 // it as (y^2 + s y + u)(y^2 - s y + v) with m = s^2 the positive root of the resolvent cubic
 // m^3 + 2 P m^2 + (P^2 - 4 R) m - Q^2 = 0, then solve both quadratics and polish every root by
@@ -238,9 +285,8 @@ int solve_quartic_closed_form(const double coeffs[5], double t_lo, double t_hi, 
             found[found_count++] = y - 0.25 * a;
         }
     } else {
-        double m[3];
-        const int n = solve_cubic(1.0, 2 * p, difference_of_products(p, p, 4.0, r), -q * q, m);
-        const double m_max = n > 0 ? m[n - 1] : 0.0;
+        const double m_max =
+            largest_cubic_root(2 * p, difference_of_products(p, p, 4.0, r), -q * q);
         if (m_max > 0) {
             const double s = std::sqrt(m_max);
             const double u = 0.5 * (p + m_max - q / s);
