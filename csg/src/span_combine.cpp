@@ -110,23 +110,23 @@ HitRecord boundary_record(BooleanOperation operation, const OperandStep& first,
 }
 
 /// A touching point of the result where it is outside on both sides of the group, or null.
-/// A zero-length span of one operand survives where the other operand lets it be part of the
-/// result's surface: anywhere for a union; where the other operand's closed set reaches for an
-/// intersection; where the subtracted operand's closed set does not reach for a difference.
-/// Two operands that merely touch end to start give no point (the regularised result is empty).
+/// A zero-length span of one operand (a tangent) survives where it lies on the result's
+/// surface: anywhere for a union; strictly inside the other operand for an intersection (two
+/// solids that touch, even where a ray is tangent to both, intersect in nothing); where the
+/// subtracted operand's closed set does not reach for a difference (A - A is empty).
 const Span* touching_point(BooleanOperation operation, const OperandStep& first,
                            const OperandStep& second) {
-    const bool first_closed = first.before || first.after || first.touched;
-    const bool second_closed = second.before || second.after || second.touched;
     switch (operation) {
         case BooleanOperation::Union:
             return first.point != nullptr ? first.point : second.point;
         case BooleanOperation::Intersection:
-            if (first.point != nullptr && second_closed) return first.point;
-            if (second.point != nullptr && first_closed) return second.point;
+            if (first.point != nullptr && second.before && second.after) return first.point;
+            if (second.point != nullptr && first.before && first.after) return second.point;
             return nullptr;
-        case BooleanOperation::Difference:
+        case BooleanOperation::Difference: {
+            const bool second_closed = second.before || second.after || second.touched;
             return first.point != nullptr && !second_closed ? first.point : nullptr;
+        }
     }
     return nullptr;
 }
