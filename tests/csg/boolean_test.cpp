@@ -287,9 +287,9 @@ TEST(Boolean, NestedDifferencesFlipTwiceAndInstancesMapNormals) {
     // The bite, stretched by 2 along x and moved by 10 along z: normals map by the inverse
     // transpose after the flip, hits still name the leaf.
     const auto b = sphere(Point3(1, 0, 0), 0.5);
-    const Instance placed(boolean(kDifference, sphere(Point3(0, 0, 0), 1), b),
-                          Transform::translate(Vector3(0, 0, 10)) *
-                              Transform::scale(Vector3(2, 1, 1)));
+    const Instance placed(
+        boolean(kDifference, sphere(Point3(0, 0, 0), 1), b),
+        Transform::translate(Vector3(0, 0, 10)) * Transform::scale(Vector3(2, 1, 1)));
     hit = placed.intersect(Ray{Point3(5, 0, 10), Vector3(-1, 0, 0)});
     ASSERT_TRUE(hit);
     EXPECT_NEAR(hit->t, 4.0, 1e-15);  // the bite's surface at object x = 0.5, world x = 1
@@ -339,12 +339,11 @@ TEST(Boolean, IntervalHonouredAtBothEndsAndRaysFromInside) {
 TEST(Boolean, InvalidRaysNeverHit) {
     const Boolean bite(kDifference, sphere(Point3(0, 0, 0), 1), sphere(Point3(1, 0, 0), 0.5));
     const double nan = std::nan("");
-    for (const Ray& ray : {Ray{Point3(nan, 0, -5), Vector3(0, 0, 1)},
-                           Ray{Point3(0, 0, -5), Vector3(0, nan, 1)},
-                           Ray{Point3(0, 0, -5), Vector3(0, 0, 0)},
-                           Ray{Point3(0, 0, -kInfinity), Vector3(0, 0, 1)},
-                           Ray{Point3(0, 0, -5), Vector3(0, 0, 1), nan, kInfinity},
-                           Ray{Point3(0, 0, -5), Vector3(0, 0, 1), 5.0, 4.0}}) {
+    for (const Ray& ray :
+         {Ray{Point3(nan, 0, -5), Vector3(0, 0, 1)}, Ray{Point3(0, 0, -5), Vector3(0, nan, 1)},
+          Ray{Point3(0, 0, -5), Vector3(0, 0, 0)}, Ray{Point3(0, 0, -kInfinity), Vector3(0, 0, 1)},
+          Ray{Point3(0, 0, -5), Vector3(0, 0, 1), nan, kInfinity},
+          Ray{Point3(0, 0, -5), Vector3(0, 0, 1), 5.0, 4.0}}) {
         EXPECT_FALSE(bite.intersect(ray));
         EXPECT_FALSE(bite.occluded(ray));
         EXPECT_TRUE(bite.spans(ray).empty());
@@ -393,8 +392,8 @@ TEST(Boolean, SkipsWhatTheRayDoesNotNeed) {
     const auto left = counted(Point3(-3, 0, 0));
     const auto right = counted(Point3(3, 0, 0));
     const Boolean pair(kUnion, left, right);
-    for (const Ray& ray : {Ray{Point3(-10, 0, 0), Vector3(1, 0, 0)},
-                           Ray{Point3(10, 0, 0), Vector3(-1, 0, 0)}}) {
+    for (const Ray& ray :
+         {Ray{Point3(-10, 0, 0), Vector3(1, 0, 0)}, Ray{Point3(10, 0, 0), Vector3(-1, 0, 0)}}) {
         reset({left.get(), right.get()});
         const std::optional<Hit> hit = pair.intersect(ray);
         ASSERT_TRUE(hit);
@@ -450,7 +449,8 @@ TEST(BooleanCoincident, SolidMinusItselfIsEmpty) {
     for (const std::shared_ptr<const Shape>& solid :
          std::initializer_list<std::shared_ptr<const Shape>>{ball, ellipsoid}) {
         const Boolean nothing(kDifference, solid, solid);
-        const Boolean same_union(kUnion, solid, solid), same_intersection(kIntersection, solid, solid);
+        const Boolean same_union(kUnion, solid, solid),
+            same_intersection(kIntersection, solid, solid);
         int solid_hits = 0;
         for (int i = 0; i < 20000; ++i) {
             Ray ray = random.ray_between(test::enlarged(solid->bounds(), 1.0), solid->bounds());
