@@ -5,13 +5,23 @@
 
 namespace csgrt {
 
-double span_coincidence_tolerance(const Ray& ray, double t) {
+namespace {
+
+// Ends are rounded like the coordinates of the points they name, |o| + |t d|, divided by |d|
+// to turn a distance into t (max norms: no square roots, within sqrt(3) of the 2-norm).
+double origin_over_direction(const Ray& ray) {
+    return ray.origin.cwiseAbs().maxCoeff() / ray.direction.cwiseAbs().maxCoeff();
+}
+
+double coincidence_tolerance(double origin_over_direction, double t) {
     if (!std::isfinite(t)) return 0.0;
-    // Ends are rounded like the coordinates of the points they name, |o| + |t d|, divided by |d|
-    // to turn a distance into t (max norms: no square roots, within sqrt(3) of the 2-norm).
-    const double origin_over_direction =
-        ray.origin.cwiseAbs().maxCoeff() / ray.direction.cwiseAbs().maxCoeff();
     return kSpanCoincidenceUlps * kUnitRoundoff * (std::abs(t) + origin_over_direction);
+}
+
+}  // namespace
+
+double span_coincidence_tolerance(const Ray& ray, double t) {
+    return coincidence_tolerance(origin_over_direction(ray), t);
 }
 
 namespace {
@@ -139,6 +149,7 @@ void sweep(BooleanOperation operation, const SpanList& first_spans, const SpanLi
            const Ray& ray, Visitor& visitor) {
     Cursor first(first_spans);
     Cursor second(second_spans);
+    const double scale = origin_over_direction(ray);
     while (!first.done() || !second.done()) {
         const double first_t = first.next_t();
         const double second_t = second.next_t();
@@ -146,7 +157,7 @@ void sweep(BooleanOperation operation, const SpanList& first_spans, const SpanLi
         if (!visitor.group(t)) return;
         // A group is every end within the tolerance of its earliest one; the negated tests
         // step an operand with a NaN end rather than skipping it forever.
-        const double limit = t + span_coincidence_tolerance(ray, t);
+        const double limit = t + coincidence_tolerance(scale, t);
         const OperandStep a = !(first_t > limit) ? first.advance(limit) : first.stay();
         const OperandStep b = !(second_t > limit) ? second.advance(limit) : second.stay();
         const bool before = classify(operation, a.before, b.before);
