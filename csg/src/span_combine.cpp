@@ -18,14 +18,6 @@ double coincidence_tolerance(double origin_over_direction, double t) {
     return kSpanCoincidenceUlps * kUnitRoundoff * (std::abs(t) + origin_over_direction);
 }
 
-}  // namespace
-
-double span_coincidence_tolerance(const Ray& ray, double t) {
-    return coincidence_tolerance(origin_over_direction(ray), t);
-}
-
-namespace {
-
 /// What one operand does within a group of ends that count as coincident.
 struct OperandStep {
     bool before = false;   // inside just before the group
@@ -208,6 +200,10 @@ struct FirstBoundary {
 };
 
 }  // namespace
+
+double span_coincidence_tolerance(const Ray& ray, double t) {
+    return coincidence_tolerance(origin_over_direction(ray), t);
+}
 
 void combine_spans(BooleanOperation operation, const SpanList& first, const SpanList& second,
                    const Ray& ray, SpanList& result) {
