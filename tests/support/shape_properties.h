@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <functional>
 #include <string>
@@ -12,8 +14,8 @@
 namespace csgrt::test {
 
 /// An independent description of a shape's surface for property tests: an implicit function
-/// that is zero on the surface, and its gradient. For part objects, `on_surface` may further
-/// restrict where a hit may lie.
+/// that is zero on the surface, and its gradient. (Part objects check their limits in their
+/// own tests.)
 struct SurfaceDescription {
     std::function<double(const Point3&)> value;
     std::function<Vector3(const Point3&)> gradient;
