@@ -91,13 +91,11 @@ detail::LineInterval Cone::side_interval(const Ray& ray) const {
     // parallel to the axis of a cylinder-like cone).
     if (!(a < 0.0 || (a == 0.0 && c <= 0.0))) return line;
     if (rate == 0.0) {
-        // Then a == 0 means a vertical line, inside (or, when c == 0, on) a cylinder-like cone.
+        // Then a == 0 means a vertical line, inside (or on) a cylinder-like cone.
         line.t0 = -kInfinity;
         line.t1 = kInfinity;
-        line.in_surface = c == 0.0;
         return line;
     }
-    line.in_surface = a == 0.0;
     // Our nappe is the side of the apex plane where rho > 0.
     const double t_apex = shift - radius / rate;
     if (rate > 0.0) {
@@ -143,7 +141,7 @@ detail::LineInterval Cone::solid_interval(const Ray& ray) const {
     if (!pointed_ || !apex_on_line(ray, t_apex)) return span;
     // The solid is convex and holds its apex: a line through the apex meets it in a segment
     // containing t_apex. Extend to it, and attribute ends near it to it.
-    if (span.empty()) return detail::LineInterval{t_apex, t_apex, kApex, kApex, false};
+    if (span.empty()) return detail::LineInterval{t_apex, t_apex, kApex, kApex};
     const double reach = apex_reach(ray);
     if (t_apex <= span.t0 + reach) {
         span.t0 = t_apex;
@@ -173,8 +171,8 @@ bool Cone::nearest(const Ray& ray, double& t, std::uint32_t& surface) const {
         return false;
     }
     bool found = detail::nearest_open_surface_hit(
-        ray, side_interval(ray), detail::slab_interval(ray, 0.0, height_, kBaseCap, kTopCap), kSide,
-        t, surface);
+        ray, side_interval(ray), detail::slab_interval(ray, 0.0, height_, kBaseCap, kTopCap), t,
+        surface);
     double t_apex;
     if (pointed_ && apex_on_line(ray, t_apex) && ray.in_range(t_apex) &&
         (!found || t_apex <= t + apex_reach(ray))) {

@@ -20,12 +20,10 @@ LineInterval infinite_cylinder_interval(const Ray& ray, double radius, std::uint
     const double a = dx * dx + dz * dz;
     const double radius_squared = radius * radius;
     if (a == 0.0) {
-        // Parallel to the axis: inside along the whole line or nowhere.
-        const double c = std::fma(x, x, std::fma(z, z, -radius_squared));
-        if (c <= 0.0) {
+        // Parallel to the axis: inside (or on the side) along the whole line, or nowhere.
+        if (std::fma(x, x, std::fma(z, z, -radius_squared)) <= 0.0) {
             line.t0 = -kInfinity;
             line.t1 = kInfinity;
-            line.in_surface = c == 0.0;
         }
         return line;
     }
@@ -67,9 +65,9 @@ LineInterval slab_interval(const Ray& ray, double lower, double upper, std::uint
     const double t_lower = (lower - origin) / direction;
     const double t_upper = (upper - origin) / direction;
     if (direction > 0.0) {
-        slab = LineInterval{t_lower, t_upper, lower_surface, upper_surface, false};
+        slab = LineInterval{t_lower, t_upper, lower_surface, upper_surface};
     } else {
-        slab = LineInterval{t_upper, t_lower, upper_surface, lower_surface, false};
+        slab = LineInterval{t_upper, t_lower, upper_surface, lower_surface};
     }
     return slab;
 }
@@ -94,19 +92,9 @@ LineInterval overlap(const LineInterval& a, const LineInterval& b) {
 }
 
 bool nearest_open_surface_hit(const Ray& ray, const LineInterval& side, const LineInterval& slab,
-                              std::uint32_t side_surface, double& t, std::uint32_t& surface) {
-    if (side.empty()) return false;
-    if (side.in_surface) {
-        // The ray touches the surface along a segment: report where it first does so in range.
-        const LineInterval contact = overlap(side, slab);
-        const double first = std::max(contact.t0, ray.t_min);
-        if (!(first <= std::min(contact.t1, ray.t_max)) || !std::isfinite(first)) return false;
-        t = first;
-        surface = first == side.t0 ? side.surface0 : side_surface;
-        return true;
-    }
+                              double& t, std::uint32_t& surface) {
     // The ends of the inside interval are where the line crosses the surface; infinite ends
-    // are not crossings.
+    // (a line along the axis, or lying in the surface) are not crossings.
     const double ends[2] = {side.t0, side.t1};
     const std::uint32_t surfaces[2] = {side.surface0, side.surface1};
     for (int i = 0; i < 2; ++i) {
@@ -146,7 +134,7 @@ bool Cylinder::nearest(const Ray& ray, double& t, std::uint32_t& surface) const 
     if (side.empty()) return false;
     const detail::LineInterval slab =
         detail::slab_interval(ray, y_min_, y_max_, kBottomCap, kTopCap);
-    if (!capped_) return detail::nearest_open_surface_hit(ray, side, slab, kSide, t, surface);
+    if (!capped_) return detail::nearest_open_surface_hit(ray, side, slab, t, surface);
     // The solid is the infinite solid cylinder cut by the slab: its span is the overlap of the
     // two intervals, so the rim is watertight by construction (no point-in-disk test).
     const detail::LineInterval span = detail::overlap(side, slab);

@@ -48,13 +48,8 @@ bool PartCylinder::nearest(const Ray& ray, double& t) const {
     if (side.empty()) return false;
     const detail::LineInterval slab =
         detail::slab_interval(ray, y_min_, y_max_, Cylinder::kBottomCap, Cylinder::kTopCap);
-    if (side.in_surface) {
-        // Parallel to the axis on the surface: the whole contact line has the origin's azimuth.
-        if (!includes_azimuth(detail::azimuth(ray.origin.x(), ray.origin.z()))) return false;
-        std::uint32_t surface;
-        return detail::nearest_open_surface_hit(ray, side, slab, Cylinder::kSide, t, surface);
-    }
     // Nearest crossing first; one in the removed sector lets the ray on to the far crossing.
+    // Infinite ends (a line along the axis, or lying in the surface) are not crossings.
     for (const double end : {side.t0, side.t1}) {
         if (!std::isfinite(end) || !(slab.t0 <= end && end <= slab.t1) || !ray.in_range(end)) {
             continue;

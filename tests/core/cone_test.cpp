@@ -179,19 +179,17 @@ TEST(Cone, RaysAimedAtTheApexFromEverywhereHitIt) {
 }
 
 TEST(Cone, RayAlongAGenerator) {
-    // rho(y) = 1 - y: the generator from (1, 0, 0) to the apex (0, 1, 0); contact for t in [1, 2].
+    // rho(y) = 1 - y: the generator from (1, 0, 0) to the apex (0, 1, 0), t in [1, 2]. The ray
+    // crosses nothing, but passes the apex, which the open cone reports; the solid's span runs
+    // from the rim to the apex.
     const Cone open(1.0, 0.0, 1.0, false);
     const Cone capped(1.0, 0.0, 1.0, true);
     const Ray along{Point3(2, -1, 0), Vector3(-1, 1, 0)};
     std::optional<Hit> hit = open.intersect(along);
     ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 1.0);
-    EXPECT_EQ(hit->primitive_id, Cone::kSide);
-    EXPECT_TRUE(hit->geometric_normal.isApprox(Normal3(1, 1, 0).normalized(), 1e-15));
-    EXPECT_FALSE(hit->front_face);  // d . n = 0
+    EXPECT_EQ(hit->t, 2.0);
+    EXPECT_EQ(hit->primitive_id, Cone::kApex);
     Ray later = along;
-    later.t_min = 1.5;
-    EXPECT_EQ(open.intersect(later)->t, 1.5);
     later.t_min = 2.5;
     EXPECT_FALSE(open.intersect(later));
     hit = capped.intersect(along);
@@ -201,6 +199,15 @@ TEST(Cone, RayAlongAGenerator) {
     later.t_min = 1.5;
     EXPECT_EQ(capped.intersect(later)->t, 2.0);
     EXPECT_EQ(capped.intersect(later)->primitive_id, Cone::kApex);
+    // A frustum has no apex: its open side is missed, its solid hit at both rims.
+    const Ray along_frustum{Point3(3, -1, 0), Vector3(-1, 1, 0)};  // rho(y) = 2 - y
+    EXPECT_FALSE(Cone(2.0, 1.0, 1.0, false).intersect(along_frustum));
+    const SpanList spans = Cone(2.0, 1.0, 1.0, true).spans(along_frustum);
+    ASSERT_EQ(spans.size(), 1u);
+    EXPECT_EQ(spans[0].enter.t, 1.0);
+    EXPECT_EQ(spans[0].enter.primitive, Cone::kBaseCap);
+    EXPECT_EQ(spans[0].exit.t, 2.0);
+    EXPECT_EQ(spans[0].exit.primitive, Cone::kTopCap);
 }
 
 TEST(Cone, TangentToTheSide) {
@@ -233,9 +240,9 @@ TEST(Cone, ParallelToTheAxis) {
     EXPECT_FALSE(tube.intersect(Ray{Point3(0.5, 5, 0), Vector3(0, -1, 0)}));
     EXPECT_EQ(Cone(1.0, 1.0, 2.0, true).intersect(Ray{Point3(0.5, 5, 0), Vector3(0, -1, 0)})->t,
               3.0);
-    // ... unless lying in it: 0.6^2 + 0.8^2 - 1 need not be 0 in double, 3, 4, 5 is.
-    const Cone wide_tube(5.0, 5.0, 2.0, false);
-    EXPECT_EQ(wide_tube.intersect(Ray{Point3(3, 5, 4), Vector3(0, -1, 0)})->t, 3.0);
+    // ... not even lying in it (3, 4, 5: exactly on the side in double).
+    EXPECT_FALSE(Cone(5.0, 5.0, 2.0, false).intersect(Ray{Point3(3, 5, 4), Vector3(0, -1, 0)}));
+    EXPECT_EQ(Cone(5.0, 5.0, 2.0, true).intersect(Ray{Point3(3, 5, 4), Vector3(0, -1, 0)})->t, 3.0);
 }
 
 TEST(Cone, IntervalHonouredAtBothEnds) {

@@ -57,37 +57,38 @@ TEST(Cylinder, ParallelToTheAxisHitsTheCapsOfTheSolidOnly) {
     EXPECT_FALSE(kCapped.intersect(Ray{Point3(1.5, 5, 0), Vector3(0, -1, 0)}));
 }
 
-TEST(Cylinder, RayLyingInTheSideTouchesItAlongASegment) {
-    // 3^2 + 4^2 - 5^2 is exactly 0 in double: the ray lies in the side.
+TEST(Cylinder, RayLyingInTheSide) {
+    // 3^2 + 4^2 - 5^2 is exactly 0 in double: the ray lies in the side, touching it for t in
+    // [9, 11]. It crosses nothing, so the open tube is missed (wherever t_min is); the solid is
+    // hit at the rims, the ends of its span.
     const Cylinder open(5.0, -1.0, 1.0, false);
     const Cylinder capped(5.0, -1.0, 1.0, true);
-    const Ray up{Point3(3, -10, 4), Vector3(0, 1, 0)};  // contact for t in [9, 11]
-    std::optional<Hit> hit = open.intersect(up);
-    ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 9.0);
-    EXPECT_EQ(hit->primitive_id, Cylinder::kSide);
-    EXPECT_TRUE(hit->geometric_normal.isApprox(Normal3(0.6, 0, 0.8)));
-    EXPECT_FALSE(hit->front_face);  // d . n = 0: not arriving from the front
-    Ray later = up;
-    later.t_min = 10.0;
-    ASSERT_TRUE(open.intersect(later));
-    EXPECT_EQ(open.intersect(later)->t, 10.0);  // the segment's first point in range
-    later.t_min = 11.5;
-    EXPECT_FALSE(open.intersect(later));
-    EXPECT_FALSE(open.occluded(later));
-    // The solid reports the rims, the ends of its span.
-    hit = capped.intersect(up);
+    const Ray up{Point3(3, -10, 4), Vector3(0, 1, 0)};
+    for (const double t_min : {0.0, 9.0, 10.0}) {
+        Ray ray = up;
+        ray.t_min = t_min;
+        EXPECT_FALSE(open.intersect(ray)) << t_min;
+        EXPECT_FALSE(open.occluded(ray)) << t_min;
+    }
+    std::optional<Hit> hit = capped.intersect(up);
     ASSERT_TRUE(hit);
     EXPECT_EQ(hit->t, 9.0);
     EXPECT_EQ(hit->primitive_id, Cylinder::kBottomCap);
+    EXPECT_EQ(hit->point, Point3(3, -1, 4));
+    Ray later = up;
     later.t_min = 10.0;
-    ASSERT_TRUE(capped.intersect(later));
-    EXPECT_EQ(capped.intersect(later)->t, 11.0);
-    EXPECT_EQ(capped.intersect(later)->primitive_id, Cylinder::kTopCap);
-    // A hair inside: the open tube is missed, the solid still hit through its caps.
+    hit = capped.intersect(later);
+    ASSERT_TRUE(hit);
+    EXPECT_EQ(hit->t, 11.0);
+    EXPECT_EQ(hit->primitive_id, Cylinder::kTopCap);
+    const SpanList spans = capped.spans(up);
+    ASSERT_EQ(spans.size(), 1u);
+    EXPECT_EQ(spans[0].enter.t, 9.0);
+    EXPECT_EQ(spans[0].exit.t, 11.0);
+    // A hair inside, the solid is still hit through its caps; a hair outside, nothing is.
     const Ray inside{Point3(3, -10, std::nextafter(4.0, 0.0)), Vector3(0, 1, 0)};
     EXPECT_FALSE(open.intersect(inside));
-    EXPECT_TRUE(capped.intersect(inside));
+    EXPECT_EQ(capped.intersect(inside)->t, 9.0);
     const Ray outside{Point3(3, -10, std::nextafter(4.0, 5.0)), Vector3(0, 1, 0)};
     EXPECT_FALSE(open.intersect(outside));
     EXPECT_FALSE(capped.intersect(outside));

@@ -25,8 +25,9 @@ namespace csgrt {
 /// one at the base: the mean of the surrounding side normals, finite and unit length.
 ///
 /// uv on the side: (phi / 2 pi, y / height); on a cap: (phi / 2 pi, distance from the axis /
-/// cap radius); at the apex: (0, y / height). A ray lying in the side (along a generator) is
-/// hit at the first point of its contact segment, as on an open Cylinder.
+/// cap radius); at the apex: (0, y / height). A ray lying in the side (along a generator)
+/// crosses nothing, as on an open Cylinder, but passes the apex of a pointed cone and so hits
+/// that; the capped solid is hit where its span begins (a rim or the apex).
 class Cone final : public Shape {
 public:
     /// Which surface a hit lies on: HitRecord::primitive and Hit::primitive_id.

@@ -17,10 +17,11 @@ namespace csgrt {
 /// [0, 2 pi); on a cap: (phi / 2 pi, distance from the axis / radius), so u matches the side's
 /// along the rim.
 ///
-/// A ray parallel to the axis never crosses the side. When it lies exactly in the side
-/// (x^2 + z^2 - radius^2 evaluates to 0) it touches the surface along a segment: the open
-/// cylinder reports the segment's first point in [t_min, t_max]; the capped solid reports the
-/// caps' rims, which are the ends of its span.
+/// A ray parallel to the axis never crosses the side, not even one lying exactly in it
+/// (x^2 + z^2 - radius^2 evaluates to 0): it has no single crossing point, and a hit at its
+/// first point of contact would be at t_min whatever t_min is, so a ray spawned along the
+/// surface would always re-hit it. The open cylinder is therefore missed, as flat shapes are
+/// by rays in their plane; the capped solid is hit at its caps' rims, the ends of its span.
 class Cylinder final : public Shape {
 public:
     /// Which surface a hit lies on: HitRecord::primitive and Hit::primitive_id.
@@ -57,14 +58,12 @@ private:
 namespace detail {
 
 /// The closed part [t0, t1] of a ray's line inside a solid, with the surface each end lies on.
-/// Either end may be infinite; an empty interval has t0 > t1. `in_surface` says the whole
-/// line lies in the (unlimited) surface, as a ray along a cylinder's side does.
+/// Either end may be infinite (not a crossing); an empty interval has t0 > t1.
 struct LineInterval {
     double t0 = kInfinity;
     double t1 = -kInfinity;
     std::uint32_t surface0 = 0;
     std::uint32_t surface1 = 0;
-    bool in_surface = false;
 
     bool empty() const { return !(t0 <= t1); }
 };
@@ -85,12 +84,10 @@ LineInterval slab_interval(const Ray& ray, double lower, double upper, std::uint
 /// ties keep `a`'s surface.
 LineInterval overlap(const LineInterval& a, const LineInterval& b);
 
-/// The nearest point in [t_min, t_max] where the ray meets the side of an open surface of
-/// revolution limited to `slab`: an end of `side` inside the slab or, when the ray lies in the
-/// surface, the first point of the contact segment (labelled `side_surface` unless it is an
-/// end of `side` itself).
+/// The nearest point in [t_min, t_max] where the ray crosses the side of an open surface of
+/// revolution limited to `slab`: a finite end of `side` inside the slab, with its label.
 bool nearest_open_surface_hit(const Ray& ray, const LineInterval& side, const LineInterval& slab,
-                              std::uint32_t side_surface, double& t, std::uint32_t& surface);
+                              double& t, std::uint32_t& surface);
 
 /// Azimuth atan2(x, z) wrapped to [0, 2 pi).
 double azimuth(double x, double z);

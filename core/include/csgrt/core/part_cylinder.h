@@ -14,8 +14,7 @@ namespace csgrt {
 ///
 /// uv: ((phi - phi_min) / (phi_max - phi_min), (y - y_min) / (y_max - y_min)), with phi taken
 /// in [phi_min, phi_min + 2 pi). A ray lying in the surface (parallel to the axis at exactly the
-/// radius, in an included azimuth) is hit at the first point of its contact segment, as on an
-/// open Cylinder.
+/// radius) misses it, as it misses an open Cylinder.
 class PartCylinder final : public Shape {
 public:
     /// Throws InvalidParameter unless radius > 0 and finite, y_min < y_max both finite, and the
