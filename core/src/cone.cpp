@@ -45,18 +45,17 @@ detail::LineInterval Cone::side_interval(const Ray& ray) const {
     const Vector3 to_center = center_ - o;
     if (to_center.squaredNorm() > 4.0 * size_ * size_) {
         shift = to_center.dot(d) / d.squaredNorm();
-        o = Point3(std::fma(shift, d.x(), o.x()), std::fma(shift, d.y(), o.y()),
-                   std::fma(shift, d.z(), o.z()));
+        o += shift * d;
     }
     // F(t) = x^2 + z^2 - rho(y)^2 along the line, with rho(y(t)) = radius + rate t; rho < 0 is
     // the other nappe. That nappe lies beyond the apex plane, which is a slab plane or outside
     // the slab, so a piece of the line inside it never survives the slab: only a line that
     // runs through both nappes (a < 0) needs choosing.
-    const double radius = std::fma(slope_, o.y(), base_radius_);
+    const double radius = base_radius_ + slope_ * o.y();
     const double rate = slope_ * d.y();
-    const double a = std::fma(-rate, rate, d.x() * d.x() + d.z() * d.z());
+    const double a = d.x() * d.x() + d.z() * d.z() - rate * rate;
     const double b = o.x() * d.x() + o.z() * d.z() - radius * rate;
-    const double c = std::fma(-radius, radius, o.x() * o.x() + o.z() * o.z());
+    const double c = o.x() * o.x() + o.z() * o.z() - radius * radius;
     double roots[2];
     const int count = solve_quadratic(a, 2.0 * b, c, roots);
     if (count == 2) {
