@@ -86,8 +86,8 @@ detail::LineInterval Cone::side_interval(const Ray& ray) const {
         return line;
     }
     // No crossing, yet inside all along when a < 0 (rounding has hidden the double root of a
-    // line through the apex) or a == b == 0 <= -c (a line in the side, through the apex, or
-    // parallel to the axis of a cylinder-like cone).
+    // line through the apex), or when a == b == 0 and c <= 0 (a line lying in the side, which
+    // passes the apex, or one parallel to the axis inside a cylinder-like cone).
     if (!(a < 0.0 || (a == 0.0 && c <= 0.0))) return line;
     if (rate == 0.0) {
         // Then a == 0 means a vertical line, inside (or on) a cylinder-like cone.
