@@ -22,6 +22,9 @@ struct HitRecord {
     /// The instances between the query's root and the leaf, as an index into the query's
     /// QueryScratch (kNoIndex: none).
     std::uint32_t instance_path = kNoIndex;
+    /// Which member of a shape set (a compound's child, a scene's object) the hit belongs to;
+    /// the outermost set writes it last, so at the top it is the scene object.
+    std::uint32_t object = kNoIndex;
     /// Surface parameters the leaf chose to keep (barycentrics for triangles); leaf-defined.
     float u = 0.0f;
     float v = 0.0f;

@@ -1,7 +1,10 @@
 #pragma once
 
 // Every shape of the geometry kernel, for code that wants them all (the scene loader, tests).
+#include "csgrt/core/cone.h"
+#include "csgrt/core/cylinder.h"
 #include "csgrt/core/instance.h"
+#include "csgrt/core/part_cylinder.h"
 #include "csgrt/core/part_torus.h"
 #include "csgrt/core/sphere.h"
 #include "csgrt/core/torus.h"

@@ -1,0 +1,116 @@
+#include "csgrt/accel/brute_force.h"
+
+#include <chrono>
+
+#include "csgrt/accel/shape_set.h"
+#include "csgrt/accel/triangle_set.h"
+
+namespace csgrt {
+
+template <class Set>
+void BruteForce<Set>::build(const Set& set, const BruteForceConfig& config) {
+    const auto start = std::chrono::steady_clock::now();
+    set_ = &set;
+    config_ = config;
+    boxes_.clear();
+    if (config.box_culling) {
+        boxes_.reserve(set.size());
+        for (std::size_t i = 0; i < set.size(); ++i) boxes_.push_back(set.bounds(i));
+    }
+    stats_ = AcceleratorStats{};
+    stats_.name = config.box_culling ? "brute (box culling)" : "brute";
+    stats_.bytes = boxes_.capacity() * sizeof(Aabb);
+    stats_.primitives = stats_.references = set.size();
+    stats_.build_milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+template <class Set>
+bool BruteForce<Set>::intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
+    TraversalCounters unused;
+    return intersect_impl<false>(ray, record, scratch, unused);
+}
+
+template <class Set>
+bool BruteForce<Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
+    TraversalCounters unused;
+    return occluded_impl<false>(ray, scratch, unused);
+}
+
+template <class Set>
+bool BruteForce<Set>::intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                                        TraversalCounters& counters) const {
+    return intersect_impl<true>(ray, record, scratch, counters);
+}
+
+template <class Set>
+bool BruteForce<Set>::occluded_counted(const Ray& ray, QueryScratch& scratch,
+                                       TraversalCounters& counters) const {
+    return occluded_impl<true>(ray, scratch, counters);
+}
+
+template <class Set>
+bool BruteForce<Set>::may_hit(std::size_t i, const Ray& ray, const Vector3& inverse_direction,
+                              double t_max) const {
+    if (!config_.box_culling) return true;
+    Ray bounded = ray;
+    bounded.t_max = t_max;
+    double t_enter, t_exit;
+    return boxes_[i].intersect(bounded, inverse_direction, t_enter, t_exit);
+}
+
+template <class Set>
+template <bool kCount>
+bool BruteForce<Set>::intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                                     TraversalCounters& counters) const {
+    if (set_ == nullptr) return false;
+    const auto prepared = set_->prepare(ray, scratch);
+    const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    HitRecord best;
+    best.t = ray.t_max;
+    bool found = false;
+    for (std::size_t i = 0; i < set_->size(); ++i) {
+        if constexpr (kCount) counters.boxes_tested += config_.box_culling ? 1 : 0;
+        if (!may_hit(i, ray, inverse_direction, best.t)) continue;
+        if constexpr (kCount) ++counters.primitives_tested;
+        found |= set_->intersect(i, prepared, best);
+    }
+    if (found) record = best;
+    return found;
+}
+
+template <class Set>
+template <bool kCount>
+bool BruteForce<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
+                                    TraversalCounters& counters) const {
+    if (set_ == nullptr) return false;
+    const auto prepared = set_->prepare(ray, scratch);
+    const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    for (std::size_t i = 0; i < set_->size(); ++i) {
+        if constexpr (kCount) counters.boxes_tested += config_.box_culling ? 1 : 0;
+        if (!may_hit(i, ray, inverse_direction, ray.t_max)) continue;
+        if constexpr (kCount) ++counters.primitives_tested;
+        if (set_->occluded(i, prepared)) return true;
+    }
+    return false;
+}
+
+template <class Set>
+void BruteForce<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
+                               QueryScratch& scratch) const {
+    if (set_ == nullptr) return;
+    const auto prepared = set_->prepare(ray, scratch);
+    const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    for (std::size_t i = 0; i < set_->size(); ++i) {
+        if (!may_hit(i, ray, inverse_direction, ray.t_max)) continue;
+        HitRecord record;
+        record.t = ray.t_max;
+        if (set_->intersect(i, prepared, record)) hits.push_back(record);
+    }
+}
+
+template class BruteForce<TriangleSet<float>>;
+template class BruteForce<TriangleSet<double>>;
+template class BruteForce<ShapeSet>;
+
+}  // namespace csgrt

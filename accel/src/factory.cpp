@@ -1,0 +1,44 @@
+#include "csgrt/accel/factory.h"
+
+#include <array>
+#include <string>
+
+#include "csgrt/accel/shape_set.h"
+#include "csgrt/accel/triangle_set.h"
+#include "csgrt/core/error.h"
+
+namespace csgrt {
+
+namespace {
+constexpr std::array<std::string_view, 1> kNames = {"brute"};
+
+template <class Structure, class Set, class Config>
+std::unique_ptr<Accelerator<Set>> build(const Set& set, const Config& config) {
+    auto structure = std::make_unique<Structure>();
+    structure->build(set, config);
+    return structure;
+}
+}  // namespace
+
+std::span<const std::string_view> accelerator_names() {
+    return kNames;
+}
+
+template <class Set>
+std::unique_ptr<Accelerator<Set>> make_accelerator(std::string_view name, const Set& set,
+                                                   const AcceleratorConfig& config) {
+    if (name == "brute") return build<BruteForce<Set>>(set, config.brute_force);
+    std::string known;
+    for (std::string_view n : kNames) known.append(known.empty() ? "" : ", ").append(n);
+    require(false, "make_accelerator", "name", "one of " + known, std::string(name));
+    return nullptr;
+}
+
+template std::unique_ptr<Accelerator<TriangleSet<float>>> make_accelerator(
+    std::string_view, const TriangleSet<float>&, const AcceleratorConfig&);
+template std::unique_ptr<Accelerator<TriangleSet<double>>> make_accelerator(
+    std::string_view, const TriangleSet<double>&, const AcceleratorConfig&);
+template std::unique_ptr<Accelerator<ShapeSet>> make_accelerator(std::string_view, const ShapeSet&,
+                                                                 const AcceleratorConfig&);
+
+}  // namespace csgrt
