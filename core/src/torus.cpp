@@ -97,40 +97,43 @@ int Torus::line_roots(const Ray& ray, double roots[4]) const {
     }
     if (!(t_enter < t_exit) || t_exit < ray.t_min || t_enter > ray.t_max) return 0;
 
-    // The quartic in s = t - t_shift, around a point of the line inside the bounds: its
-    // coefficients are then of size R^4 wherever the origin is (POV-Ray moves the origin for
-    // the same reason), instead of |o|^4 with catastrophic cancellation.
+    // The quartic in the distance s = (t - t_shift) |d| from a point of the line inside the
+    // bounds: its coefficients are then of size R^4 wherever the origin is (POV-Ray moves the
+    // origin for the same reason) and however long d is, instead of |o|^4 with catastrophic
+    // cancellation, or |d|^4 overflowing.
     const double t_shift = 0.5 * (t_enter + t_exit);
     const Point3 p = ray.at(t_shift);
+    const double length = direction.norm();
+    const Vector3 unit = direction / length;
     const double major2 = major * major;
-    const double a = direction.squaredNorm();
-    const double b = p.dot(direction);
+    const double a = unit.squaredNorm();
+    const double b = p.dot(unit);
     const double c = p.squaredNorm() + major2 - minor * minor;
-    const double dxz = direction.x() * direction.x() + direction.z() * direction.z();
-    const double exz = p.x() * direction.x() + p.z() * direction.z();
+    const double dxz = unit.x() * unit.x() + unit.z() * unit.z();
+    const double exz = p.x() * unit.x() + p.z() * unit.z();
     const double fxz = p.x() * p.x() + p.z() * p.z();
     // (a s^2 + 2 b s + c)^2 - 4 R^2 (dxz s^2 + 2 exz s + fxz), in ascending powers of s.
     const double coeffs[5] = {c * c - 4.0 * major2 * fxz, 4.0 * b * c - 8.0 * major2 * exz,
                               4.0 * b * b + 2.0 * a * c - 4.0 * major2 * dxz, 4.0 * a * b, a * a};
     // Absolute error bounds: gamma(8) times each coefficient's sum of absolute terms (with
-    // |p| = P, |d| = L, S = P^2 + R^2 + r^2 bounding |c|), plus the effect of p itself being
-    // off the line by e = 2 u (|o| + |t_shift| L): e times the coefficient's derivative in P,
-    // doubled.
+    // |p| = P, S = P^2 + R^2 + r^2 bounding |c|, |unit| = 1), plus the effect of the line
+    // being off by e: p by 2 u (|o| + |t_shift| |d|), and the rounded unit direction by u per
+    // unit of s, |s| <= R + 2 r. That is e times the coefficient's derivative in P, doubled.
     const double pn = p.norm();
-    const double ln = std::sqrt(a);
-    const double s = pn * pn + major2 + minor * minor;
-    const double e = 2.0 * kUnitRoundoff * (origin.norm() + std::abs(t_shift) * ln);
+    const double sum = pn * pn + major2 + minor * minor;
+    const double e =
+        2.0 * kUnitRoundoff * (origin.norm() + std::abs(t_shift) * length + major + 2.0 * minor);
     const double g8 = gamma(8);
     const double errors[5] = {
-        g8 * (s * s + 4.0 * major2 * pn * pn) + 2.0 * e * (4.0 * pn * s + 8.0 * major2 * pn),
-        g8 * (4.0 * pn * ln * s + 8.0 * major2 * pn * ln) +
-            2.0 * e * (4.0 * ln * (s + 2.0 * pn * pn) + 8.0 * major2 * ln),
-        g8 * (4.0 * pn * pn * a + 2.0 * a * s + 4.0 * major2 * dxz) +
-            2.0 * e * (8.0 * pn * a + 4.0 * a * pn),
-        g8 * 4.0 * a * pn * ln + 2.0 * e * 4.0 * a * ln, g8 * a * a};
+        g8 * (sum * sum + 4.0 * major2 * pn * pn) + 2.0 * e * (4.0 * pn * sum + 8.0 * major2 * pn),
+        g8 * (4.0 * pn * sum + 8.0 * major2 * pn) +
+            2.0 * e * (4.0 * (sum + 2.0 * pn * pn) + 8.0 * major2),
+        g8 * (4.0 * pn * pn + 2.0 * sum + 4.0 * major2) + 2.0 * e * 12.0 * pn,
+        g8 * 4.0 * pn + 2.0 * e * 4.0, g8};
     double shifted[4];
-    const int count = solve_quartic(coeffs, errors, t_enter - t_shift, t_exit - t_shift, shifted);
-    for (int i = 0; i < count; ++i) roots[i] = t_shift + shifted[i];
+    const int count = solve_quartic(coeffs, errors, (t_enter - t_shift) * length,
+                                    (t_exit - t_shift) * length, shifted);
+    for (int i = 0; i < count; ++i) roots[i] = t_shift + shifted[i] / length;
 
     // Decide near-tangencies and polish on the tube function along the original ray. Before
     // the first root the line is outside (the quartic is positive at t_enter), and each root

@@ -50,10 +50,16 @@ TEST(Torus, RayAlongXThroughTheCentreHitsAtRPlusMinusr) {
 }
 
 TEST(Torus, NonUnitDirectionScalesT) {
-    const Ray ray{Point3(-5, 0, 0), Vector3(4, 0, 0)};
-    const std::optional<Hit> hit = kTorus.intersect(ray);
-    ASSERT_TRUE(hit);
-    EXPECT_NEAR(hit->t, 2.5 / 4, 1e-15);
+    // Lengths far from 1, as deep instance hierarchies produce: |d|^4 would overflow or
+    // underflow, so the quartic is built per unit of distance.
+    for (const double length : {4.0, 1e-150, 1e150}) {
+        const Ray ray{Point3(-5, 0, 0), Vector3(length, 0, 0)};
+        const std::vector<double> roots = all_roots(kTorus, ray);
+        ASSERT_EQ(roots.size(), 4u) << length;
+        EXPECT_NEAR(roots[0] * length, 2.5, 8 * 4 * kUnitRoundoff) << length;
+        EXPECT_NEAR(roots[3] * length, 7.5, 8 * 8 * kUnitRoundoff) << length;
+        EXPECT_EQ(kTorus.intersect(ray)->t, roots[0]);
+    }
 }
 
 TEST(Torus, RayAlongTheAxisThroughTheHoleMisses) {
