@@ -263,6 +263,27 @@ TEST(Torus, ThinTubeAnalyticHits) {
     }
 }
 
+TEST(Torus, PlacedByAnInstance) {
+    // Axis turned from y to x, scaled by 3, moved 1e6 away: along z through the centre the
+    // ray crosses the tube at z = -+3 (R + r) and -+3 (R - r) around the centre.
+    const Instance placed(std::make_shared<Torus>(2.0, 0.5),
+                          Transform::translate(Vector3(1e6, 0, 0)) *
+                              Transform::rotate(Vector3(0, 0, 1), kPi / 2) *
+                              Transform::scale(Vector3(3, 3, 3)));
+    const Ray ray{Point3(1e6, 0, -10), Vector3(0, 0, 2)};
+    const std::optional<Hit> hit = placed.intersect(ray);
+    ASSERT_TRUE(hit);
+    // The object-space ray carries a few roundings (1/3, cos(pi/2) != 0), the root a few ulps
+    // more (see the analytic tests): 16 u relative covers both.
+    EXPECT_NEAR(hit->t, (10 - 7.5) / 2, 16 * kUnitRoundoff * 5);
+    EXPECT_TRUE(hit->geometric_normal.isApprox(Normal3(0, 0, -1), 1e-12));
+    const SpanList spans = placed.spans(ray);
+    ASSERT_EQ(spans.size(), 2u);
+    EXPECT_NEAR(spans[1].exit.t, (10 + 7.5) / 2, 16 * kUnitRoundoff * 10);
+    // Along the new axis (x) through the centre: the hole.
+    EXPECT_FALSE(placed.intersect(Ray{Point3(1e6 - 20, 0, 0), Vector3(1, 0, 0)}));
+}
+
 TEST(Torus, PropertiesOnRandomRays) {
     // Independent description: the quartic itself, evaluated in double. Its own rounding near
     // the surface is about 12 u (2 R rho)^2 (two terms of that size cancel), and its gradient
