@@ -23,10 +23,13 @@ double checked_major_radius(double major_radius, double minor_radius) {
 // (rho + R)^2 + y^2 - r^2, is positive for a ring torus), but near the surface its terms are
 // of size r^2 rather than R^4, so it decides and polishes roots the quartic only isolates.
 struct TubeAlongRay {
-    const Point3& origin;
-    const Vector3& direction;
-    double major_radius;
-    double minor_radius;
+    TubeAlongRay(const Ray& ray, double major, double minor)
+        : origin(ray.origin),
+          direction(ray.direction),
+          major_radius(major),
+          minor_radius(minor),
+          origin_norm(ray.origin.norm()),
+          direction_norm(ray.direction.norm()) {}
 
     // h(t), h'(t), and a bound on the rounding error of h(t): the point o + t d is off the
     // line by up to e = 2 u (|o| + |t| |d|) per coordinate; rho then by e + 2 u (rho + R)
@@ -44,7 +47,7 @@ struct TubeAlongRay {
             rho > 0.0 ? (p.x() * direction.x() + p.z() * direction.z()) / rho : 0.0;
         slope = 2.0 * (radial * rho_slope + height * direction.y());
         const double point_error =
-            2.0 * kUnitRoundoff * (origin.norm() + std::abs(t) * direction.norm());
+            2.0 * kUnitRoundoff * (origin_norm + std::abs(t) * direction_norm);
         const double radial_error = point_error + 2.0 * kUnitRoundoff * (rho + major_radius);
         error = 2.0 * (std::abs(radial) * radial_error + std::abs(height) * point_error) +
                 4.0 * kUnitRoundoff * (radial * radial + height * height + square(minor_radius));
@@ -55,6 +58,13 @@ struct TubeAlongRay {
         (*this)(t, value, slope, error);
         return value;
     }
+
+    const Point3& origin;
+    const Vector3& direction;
+    double major_radius;
+    double minor_radius;
+    double origin_norm;
+    double direction_norm;
 };
 
 }  // namespace
@@ -138,7 +148,7 @@ int Torus::line_roots(const Ray& ray, double roots[4]) const {
     // Decide near-tangencies and polish on the tube function along the original ray. Before
     // the first root the line is outside (the quartic is positive at t_enter), and each root
     // toggles, so a root's index says which side it comes from.
-    const TubeAlongRay tube{origin, direction, major, minor};
+    const TubeAlongRay tube(ray, major, minor);
     int kept = 0;
     double result[4];
     for (int i = 0; i < count;) {
