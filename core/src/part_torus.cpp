@@ -37,6 +37,33 @@ double fraction_of(double offset, double width) {
     return kTwoPi - offset < offset - width ? 0.0 : 1.0;
 }
 
+// The ranges of cos and sin over [start, start + width], start in [0, 2 pi), width <= 2 pi:
+// their values at the ends and at the quarter turns inside.
+void cos_sin_ranges(double start, double width, double& cos_lo, double& cos_hi, double& sin_lo,
+                    double& sin_hi) {
+    const double end = start + width;
+    cos_lo = std::min(std::cos(start), std::cos(end));
+    cos_hi = std::max(std::cos(start), std::cos(end));
+    sin_lo = std::min(std::sin(start), std::sin(end));
+    sin_hi = std::max(std::sin(start), std::sin(end));
+    constexpr double kQuarterCos[4] = {1, 0, -1, 0};
+    constexpr double kQuarterSin[4] = {0, 1, 0, -1};
+    for (int quarter = 0; quarter <= 8; ++quarter) {
+        const double angle = quarter * (kPi / 2);
+        if (angle < start || angle > end) continue;
+        cos_lo = std::min(cos_lo, kQuarterCos[quarter % 4]);
+        cos_hi = std::max(cos_hi, kQuarterCos[quarter % 4]);
+        sin_lo = std::min(sin_lo, kQuarterSin[quarter % 4]);
+        sin_hi = std::max(sin_hi, kQuarterSin[quarter % 4]);
+    }
+}
+
+// The range of a b for a in [a_lo, a_hi] with a_lo > 0 and b in [b_lo, b_hi].
+void product_range(double a_lo, double a_hi, double b_lo, double b_hi, double& lo, double& hi) {
+    lo = b_lo >= 0.0 ? a_lo * b_lo : a_hi * b_lo;
+    hi = b_hi >= 0.0 ? a_hi * b_hi : a_lo * b_hi;
+}
+
 }  // namespace
 
 PartTorus::PartTorus(double major_radius, double minor_radius, double phi_min, double phi_max,
@@ -45,7 +72,23 @@ PartTorus::PartTorus(double major_radius, double minor_radius, double phi_min, d
       phi_min_(checked_range_start(phi_min, phi_max, "phi_min", "phi_max")),
       phi_width_(phi_max - phi_min),
       theta_min_(checked_range_start(theta_min, theta_max, "theta_min", "theta_max")),
-      theta_width_(theta_max - theta_min) {}
+      theta_width_(theta_max - theta_min) {
+    // A surface point is (rho sin phi, r sin theta, rho cos phi) with rho = R + r cos theta.
+    double cos_theta_lo, cos_theta_hi, sin_theta_lo, sin_theta_hi;
+    cos_sin_ranges(theta_min_, theta_width_, cos_theta_lo, cos_theta_hi, sin_theta_lo,
+                   sin_theta_hi);
+    double cos_phi_lo, cos_phi_hi, sin_phi_lo, sin_phi_hi;
+    cos_sin_ranges(phi_min_, phi_width_, cos_phi_lo, cos_phi_hi, sin_phi_lo, sin_phi_hi);
+    const double rho_lo = major_radius + minor_radius * cos_theta_lo;
+    const double rho_hi = major_radius + minor_radius * cos_theta_hi;
+    double x_lo, x_hi, z_lo, z_hi;
+    product_range(rho_lo, rho_hi, sin_phi_lo, sin_phi_hi, x_lo, x_hi);
+    product_range(rho_lo, rho_hi, cos_phi_lo, cos_phi_hi, z_lo, z_hi);
+    // The sines and cosines above are rounded, and so are hit points projected on the surface.
+    const Vector3 pad = Vector3::Constant(32.0 * kUnitRoundoff * (major_radius + minor_radius));
+    bounds_ = Aabb(Point3(x_lo, minor_radius * sin_theta_lo, z_lo) - pad,
+                   Point3(x_hi, minor_radius * sin_theta_hi, z_hi) + pad);
+}
 
 void PartTorus::angle_offsets(const Point3& p, double& phi_offset, double& theta_offset) const {
     double phi, theta;

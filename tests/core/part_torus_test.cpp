@@ -177,6 +177,37 @@ TEST(PartTorus, EveryHitIsTheFirstTorusCrossingInRange) {
     EXPECT_LT(skips, 100);
 }
 
+TEST(PartTorus, BoundsHoldThePartAndOnlyIt) {
+    // Half around the axis (x >= 0), upper outer quarter of the tube (rho >= R, y >= 0).
+    const PartTorus half(kMajor, kMinor, 0.0, kPi, 0.0, kPi / 2);
+    const double pad = 32 * kUnitRoundoff * (kMajor + kMinor);
+    EXPECT_NEAR(half.bounds().lower.x(), 0.0, pad);
+    EXPECT_NEAR(half.bounds().upper.x(), kMajor + kMinor, pad);
+    EXPECT_NEAR(half.bounds().lower.y(), 0.0, pad);
+    EXPECT_NEAR(half.bounds().upper.y(), kMinor, pad);
+    EXPECT_NEAR(half.bounds().lower.z(), -(kMajor + kMinor), pad);
+    // Against sampled points of random parts (some across the seams): every point inside.
+    test::Random random(404);
+    for (int shape = 0; shape < 200; ++shape) {
+        const double phi_min = random.uniform(-kTwoPi, kTwoPi);
+        const double phi_width = random.uniform(0.01, kTwoPi);
+        const double theta_min = random.uniform(-kTwoPi, kTwoPi);
+        const double theta_width = random.uniform(0.01, kTwoPi);
+        const PartTorus part(kMajor, kMinor, phi_min, phi_min + phi_width, theta_min,
+                             theta_min + theta_width);
+        EXPECT_TRUE(Torus(kMajor, kMinor).bounds().contains(part.bounds().center()));
+        for (int i = 0; i <= 200; ++i) {
+            // The corners and edges of the angle rectangle, and random points inside it.
+            const double phi = phi_min + phi_width * (i < 100 ? (i % 10) / 9.0 : random.uniform());
+            const double theta =
+                theta_min + theta_width * (i < 100 ? (i / 10) / 9.0 : random.uniform());
+            const double rho = kMajor + kMinor * std::cos(theta);
+            const Point3 p(rho * std::sin(phi), kMinor * std::sin(theta), rho * std::cos(phi));
+            ASSERT_TRUE(part.bounds().contains(p)) << "shape " << shape << " point " << i;
+        }
+    }
+}
+
 TEST(PartTorus, IntervalHonouredAtBothEnds) {
     const PartTorus part(kMajor, kMinor, 0.0, kPi, 0.0, kTwoPi);  // kept: t = 6.5 and 7.5
     Ray ray{Point3(-5, 0, 0), Vector3(1, 0, 0)};

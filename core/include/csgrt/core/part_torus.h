@@ -23,8 +23,9 @@ public:
               double theta_min, double theta_max);
 
     std::string_view kind() const override { return "part_torus"; }
-    /// The whole torus's bounds (conservative).
-    Aabb bounds() const override { return torus_.bounds(); }
+    /// The box of the part: from the ranges of the angles' sines and cosines, padded by 32
+    /// ulps of R + r.
+    Aabb bounds() const override { return bounds_; }
 
     bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
     bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
@@ -44,6 +45,7 @@ private:
     double phi_width_;
     double theta_min_;  // wrapped into [0, 2 pi)
     double theta_width_;
+    Aabb bounds_;
 };
 
 }  // namespace csgrt
