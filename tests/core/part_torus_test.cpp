@@ -167,6 +167,10 @@ TEST(PartTorus, EveryHitIsTheFirstTorusCrossingInRange) {
             if (!hit) continue;
             ++hits;
             EXPECT_EQ(hit->t, roots[expected]);
+            long double phi, theta;
+            angles_of(hit->point, phi, theta);
+            EXPECT_TRUE(in_angle_range(phi, phi_min, phi_max, 1e-9L)) << phi;
+            EXPECT_TRUE(in_angle_range(theta, theta_min, theta_max, 1e-9L)) << theta;
             EXPECT_GE(hit->uv.x(), 0.0);
             EXPECT_LE(hit->uv.x(), 1.0);
             EXPECT_GE(hit->uv.y(), 0.0);
