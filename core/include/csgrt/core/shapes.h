@@ -2,4 +2,5 @@
 
 // Every shape of the geometry kernel, for code that wants them all (the scene loader, tests).
 #include "csgrt/core/instance.h"
+#include "csgrt/core/plane.h"
 #include "csgrt/core/sphere.h"
