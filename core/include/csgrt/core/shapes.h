@@ -4,3 +4,4 @@
 #include "csgrt/core/instance.h"
 #include "csgrt/core/plane.h"
 #include "csgrt/core/sphere.h"
+#include "csgrt/core/triangle.h"
