@@ -1,5 +1,6 @@
 #include "csgrt/core/plane.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "csgrt/core/error.h"
@@ -25,6 +26,19 @@ Vector3 normalized_or_zero(const Vector3& v) {
     const double largest = v.cwiseAbs().maxCoeff();
     if (!(largest > 0.0) || !std::isfinite(largest)) return Vector3::Zero();
     return (v / largest).normalized();
+}
+
+Aabb disk_bounds(const Point3& center, const Normal3& normal, double radius) {
+    Aabb box;
+    for (int axis = 0; axis < 3; ++axis) {
+        // sqrt(1 - n_i^2) as the norm of the other two components, which does not cancel;
+        // gamma(4) covers its rounding and the product's, the ulp steps the sums'.
+        const double other = std::hypot(normal[(axis + 1) % 3], normal[(axis + 2) % 3]);
+        const double reach = radius * std::min(other, 1.0) * (1.0 + gamma(4));
+        box.lower[axis] = next_down(center[axis] - reach);
+        box.upper[axis] = next_up(center[axis] + reach);
+    }
+    return box;
 }
 
 }  // namespace detail

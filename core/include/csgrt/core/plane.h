@@ -45,6 +45,10 @@ inline bool plane_crossing(const Ray& ray, const Point3& point, const Normal3& n
     return std::isfinite(t);
 }
 
+/// Conservative bounds of the disk of `radius` around `center` in the plane with unit normal
+/// `normal`: along axis i it reaches radius * sqrt(1 - n_i^2), rounded outward.
+Aabb disk_bounds(const Point3& center, const Normal3& normal, double radius);
+
 }  // namespace detail
 
 /// The infinite plane through `point` with normal `normal` (normalised). Not a solid.
