@@ -4,5 +4,6 @@
 #include "csgrt/core/disk.h"
 #include "csgrt/core/instance.h"
 #include "csgrt/core/plane.h"
+#include "csgrt/core/rectangle.h"
 #include "csgrt/core/sphere.h"
 #include "csgrt/core/triangle.h"
