@@ -4,6 +4,7 @@
 #include "csgrt/core/box.h"
 #include "csgrt/core/disk.h"
 #include "csgrt/core/instance.h"
+#include "csgrt/core/part_sphere.h"
 #include "csgrt/core/plane.h"
 #include "csgrt/core/rectangle.h"
 #include "csgrt/core/sphere.h"
