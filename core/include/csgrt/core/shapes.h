@@ -1,6 +1,7 @@
 #pragma once
 
 // Every shape of the geometry kernel, for code that wants them all (the scene loader, tests).
+#include "csgrt/core/annulus.h"
 #include "csgrt/core/box.h"
 #include "csgrt/core/disk.h"
 #include "csgrt/core/instance.h"
