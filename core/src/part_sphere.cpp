@@ -9,7 +9,7 @@ namespace csgrt {
 
 AzimuthRange::AzimuthRange(double phi_min, double phi_max, std::string_view what)
     : phi_min_(phi_min), phi_max_(phi_max) {
-    require(phi_min >= 0.0 && phi_min <= kTwoPi, what, "phi_min", "in [0, 2 pi]", phi_min);
+    require(phi_min >= 0.0 && phi_min < kTwoPi, what, "phi_min", "in [0, 2 pi)", phi_min);
     require(phi_max > phi_min && phi_max <= phi_min + kTwoPi, what, "phi_max",
             "in (phi_min, phi_min + 2 pi]", phi_max);
     extent_ = phi_max - phi_min;

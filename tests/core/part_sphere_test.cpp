@@ -240,7 +240,8 @@ TEST(PartSphere, RejectsBadParametersNamingThem) {
     EXPECT_TRUE(names(error_of([&] { PartSphere(Point3(nan, 0, 0), 1, 0, 1, 0, 1); }), "center"));
     // The extremes are valid: the whole sphere, and a range wrapping all the way round.
     EXPECT_NO_THROW(PartSphere(kOrigin, 1, 0, kTwoPi, 0, kPi));
-    EXPECT_NO_THROW(PartSphere(kOrigin, 1, kTwoPi, 2 * kTwoPi, 0, kPi));
+    EXPECT_NO_THROW(PartSphere(kOrigin, 1, next_down(kTwoPi), 2 * kTwoPi, 0, kPi));
+    EXPECT_TRUE(names(error(1, kTwoPi, 2 * kTwoPi, 0, 1), "phi_min"));  // that is phi_min 0
     EXPECT_TRUE(PartSphere(kOrigin, 1, 1.0, 1.0 + kTwoPi, 0, kPi).azimuth().is_full());
 }
 

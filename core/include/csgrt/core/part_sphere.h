@@ -10,11 +10,12 @@ namespace csgrt {
 /// A closed azimuth interval [phi_min, phi_max] (radians) of a part object, with the azimuth
 /// phi = atan2(x, z) in [0, 2 pi) of the y-up convention.
 ///
-/// phi_min lies in [0, 2 pi] and phi_min < phi_max <= phi_min + 2 pi, so a range may run past
-/// 2 pi and then wraps through phi = 0: [3 pi / 2, 5 pi / 2] is the half facing +z. phi_max ==
-/// phi_min + 2 pi is the full circle. Both ends belong to the range, and a point on the axis
-/// (x = z = 0) belongs to every azimuth. The seam phi = 0 = 2 pi is no boundary: a point with
-/// x = 0, z > 0 is in [0, a] and in [b, 2 pi] alike.
+/// phi_min lies in [0, 2 pi) and phi_min < phi_max <= phi_min + 2 pi (the rule PartCylinder
+/// follows too), so a range may run past 2 pi and then wraps through phi = 0: [3 pi / 2,
+/// 5 pi / 2] is the half facing +z. phi_max == phi_min + 2 pi is the full circle. Both ends
+/// belong to the range, and a point on the axis (x = z = 0) belongs to every azimuth. The seam
+/// phi = 0 = 2 pi is no boundary: a point with x = 0, z > 0 is in [0, a] and in [b, 2 pi]
+/// alike.
 class AzimuthRange {
 public:
     /// Throws InvalidParameter naming `what` and phi_min or phi_max unless they follow the
