@@ -1,24 +1,27 @@
 #pragma once
 
+#include "csgrt/core/part_sphere.h"
 #include "csgrt/core/torus.h"
 
 namespace csgrt {
 
 /// The part of a torus's surface (Torus: centred at the origin, axis +y) whose angles lie in
 /// [phi_min, phi_max] around the y axis and [theta_min, theta_max] around the tube, in
-/// radians and in Torus's parameterisation (phi = atan2(x, z); theta = 0 on the outer equator,
-/// pi / 2 on top). An open surface, not a solid.
+/// radians and in Torus's parameterisation (phi = atan2(x, z); theta = atan2(y, rho - R): 0 on
+/// the outer equator, pi / 2 on top). A part object (Suffern, "Ray Tracing from the Ground
+/// Up", 2007, ch. 19): an open surface, not a solid.
 ///
-/// A range may start anywhere and cross the seam at 0 = 2 pi: [-pi/4, pi/4] around the tube is
-/// the outer band; its width max - min must be in (0, 2 pi], and 2 pi keeps every angle. A ray
-/// through a removed part goes on to the next crossing that is kept.
+/// Both ranges follow AzimuthRange's rules (as PartCylinder and PartSphere do): min in
+/// [0, 2 pi) and min < max <= min + 2 pi, so a range crossing the seam 0 = 2 pi runs past
+/// 2 pi: theta in [7 pi / 4, 9 pi / 4] is the outer band around the equator; max = min + 2 pi
+/// keeps every angle. Both ends are included. A ray through a removed part goes on to the next
+/// crossing that is kept.
 ///
-/// uv = ((phi - phi_min) / (phi_max - phi_min), (theta - theta_min) / (theta_max - theta_min)),
-/// with the angles taken in their range: [0, 1]^2 over the part.
+/// uv = (fraction of the phi range, fraction of the theta range): [0, 1]^2 over the part.
 class PartTorus final : public Shape {
 public:
-    /// Throws InvalidParameter unless 0 < minor_radius < major_radius, every angle is finite and
-    /// each range has a width in (0, 2 pi].
+    /// Throws InvalidParameter unless 0 < minor_radius < major_radius (both finite) and both
+    /// ranges follow the rules above.
     PartTorus(double major_radius, double minor_radius, double phi_min, double phi_max,
               double theta_min, double theta_max);
 
@@ -37,14 +40,11 @@ public:
     bool keeps(const Point3& p) const;
 
 private:
-    /// The offsets of p's angles from phi_min and theta_min, each in [0, 2 pi).
-    void angle_offsets(const Point3& p, double& phi_offset, double& theta_offset) const;
-
     Torus torus_;
-    double phi_min_;  // wrapped into [0, 2 pi)
-    double phi_width_;
-    double theta_min_;  // wrapped into [0, 2 pi)
-    double theta_width_;
+    AzimuthRange phi_range_;
+    /// theta = atan2(y, rho - R) is the azimuth of the point (y, rho - R), so the same class
+    /// serves around the tube.
+    AzimuthRange theta_range_;
     Aabb bounds_;
 };
 
