@@ -481,7 +481,8 @@ TEST(SolveQuartic, ClusteredRootsWithinTheirConditioning) {
         double worst = 0;
         if (!matches(found, count, expected, worst)) {
             ++failures;
-            ADD_FAILURE() << "case " << i << "\n" << describe(p, found, count, -1, 1);
+            ADD_FAILURE() << "case " << i << "\n"
+                          << describe(p, found, count, -kInfinity, kInfinity);
         }
         (resolvable ? separate : merged)++;
     }
@@ -535,7 +536,7 @@ TEST(SolveQuartic, NearlyRealComplexPairsAreTangenciesOrNothing) {
         if (!ok) {
             ++failures;
             ADD_FAILURE() << "case " << i << " v/(u M) = " << value / scale << "\n"
-                          << describe(p, found, count, -1, 1);
+                          << describe(p, found, count, -kInfinity, kInfinity);
         }
         if (count == static_cast<int>(with.size())) ++tangent;
         if (count == static_cast<int>(without.size())) ++absent;
@@ -576,7 +577,8 @@ TEST(SolveQuartic, TripleAndQuadrupleRoots) {
                     << i;
             }
         }
-        EXPECT_EQ(near, quadruple ? 2 : 1) << i << "\n" << describe(p, found, count, -1, 1);
+        EXPECT_EQ(near, quadruple ? 2 : 1) << i << "\n"
+                                           << describe(p, found, count, -kInfinity, kInfinity);
     }
 }
 
@@ -644,7 +646,8 @@ TEST(SolveQuartic, ClosedFormOnWellConditionedRoots) {
         double worst = 0;
         if (!matches(found, count, expected, worst)) {
             ++failures;
-            ADD_FAILURE() << "case " << i << "\n" << describe(p, found, count, -1, 1);
+            ADD_FAILURE() << "case " << i << "\n"
+                          << describe(p, found, count, -kInfinity, kInfinity);
         }
     }
     // The measurement for docs/accuracy.md, on the bracketing tests' sets (same seeds).
