@@ -13,36 +13,6 @@ double checked_major_radius(double major_radius, double minor_radius) {
     return major_radius;
 }
 
-// AzimuthRange names its limits phi_min and phi_max: theta's are checked here first, by the
-// same rules, so that a message names the right parameter.
-AzimuthRange checked_theta_range(double theta_min, double theta_max) {
-    require(theta_min >= 0.0 && theta_min < kTwoPi, "PartTorus", "theta_min", "in [0, 2 pi)",
-            theta_min);
-    require(theta_max > theta_min && theta_max <= theta_min + kTwoPi, "PartTorus", "theta_max",
-            "in (theta_min, theta_min + 2 pi]", theta_max);
-    return AzimuthRange(theta_min, theta_max, "PartTorus");
-}
-
-// The ranges of cos and sin over [start, end], start in [0, 2 pi), end <= start + 2 pi: their
-// values at the ends and at the quarter turns inside.
-void cos_sin_ranges(double start, double end, double& cos_lo, double& cos_hi, double& sin_lo,
-                    double& sin_hi) {
-    cos_lo = std::min(std::cos(start), std::cos(end));
-    cos_hi = std::max(std::cos(start), std::cos(end));
-    sin_lo = std::min(std::sin(start), std::sin(end));
-    sin_hi = std::max(std::sin(start), std::sin(end));
-    constexpr double kQuarterCos[4] = {1, 0, -1, 0};
-    constexpr double kQuarterSin[4] = {0, 1, 0, -1};
-    for (int quarter = 0; quarter <= 8; ++quarter) {
-        const double angle = quarter * (kPi / 2);
-        if (angle < start || angle > end) continue;
-        cos_lo = std::min(cos_lo, kQuarterCos[quarter % 4]);
-        cos_hi = std::max(cos_hi, kQuarterCos[quarter % 4]);
-        sin_lo = std::min(sin_lo, kQuarterSin[quarter % 4]);
-        sin_hi = std::max(sin_hi, kQuarterSin[quarter % 4]);
-    }
-}
-
 // The range of a b for a in [a_lo, a_hi] with a_lo > 0 and b in [b_lo, b_hi].
 void product_range(double a_lo, double a_hi, double b_lo, double b_hi, double& lo, double& hi) {
     lo = b_lo >= 0.0 ? a_lo * b_lo : a_hi * b_lo;
@@ -55,12 +25,12 @@ PartTorus::PartTorus(double major_radius, double minor_radius, double phi_min, d
                      double theta_min, double theta_max)
     : torus_(checked_major_radius(major_radius, minor_radius), minor_radius),
       phi_range_(phi_min, phi_max, "PartTorus"),
-      theta_range_(checked_theta_range(theta_min, theta_max)) {
+      theta_range_(theta_min, theta_max, "PartTorus", "theta_min", "theta_max") {
     // A surface point is (rho sin phi, r sin theta, rho cos phi) with rho = R + r cos theta.
     double cos_theta_lo, cos_theta_hi, sin_theta_lo, sin_theta_hi;
-    cos_sin_ranges(theta_min, theta_max, cos_theta_lo, cos_theta_hi, sin_theta_lo, sin_theta_hi);
+    theta_range_.sine_cosine_bounds(sin_theta_lo, sin_theta_hi, cos_theta_lo, cos_theta_hi);
     double cos_phi_lo, cos_phi_hi, sin_phi_lo, sin_phi_hi;
-    cos_sin_ranges(phi_min, phi_max, cos_phi_lo, cos_phi_hi, sin_phi_lo, sin_phi_hi);
+    phi_range_.sine_cosine_bounds(sin_phi_lo, sin_phi_hi, cos_phi_lo, cos_phi_hi);
     const double rho_lo = major_radius + minor_radius * cos_theta_lo;
     const double rho_hi = major_radius + minor_radius * cos_theta_hi;
     double x_lo, x_hi, z_lo, z_hi;

@@ -262,7 +262,7 @@ TEST(PartTorus, RejectsBadParameters) {
         EXPECT_NE(std::string(error.what()).find("PartTorus: minor_radius"), std::string::npos)
             << error.what();
     }
-    // The ranges follow AzimuthRange's rules: min in [0, 2 pi), so no negative start.
+    // The ranges follow AngleRange's rules: min in [0, 2 pi), so no negative start.
     EXPECT_THROW(PartTorus(2.0, 0.5, -0.1, 1, 0, 1), InvalidParameter);
     EXPECT_THROW(PartTorus(2.0, 0.5, kTwoPi, 7, 0, 1), InvalidParameter);
     try {

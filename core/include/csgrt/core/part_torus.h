@@ -1,6 +1,6 @@
 #pragma once
 
-#include "csgrt/core/part_sphere.h"
+#include "csgrt/core/angle_range.h"
 #include "csgrt/core/torus.h"
 
 namespace csgrt {
@@ -11,7 +11,7 @@ namespace csgrt {
 /// the outer equator, pi / 2 on top). A part object (Suffern, "Ray Tracing from the Ground
 /// Up", 2007, ch. 19): an open surface, not a solid.
 ///
-/// Both ranges follow AzimuthRange's rules (as PartCylinder and PartSphere do): min in
+/// Both ranges follow AngleRange's rules (as PartCylinder and PartSphere do): min in
 /// [0, 2 pi) and min < max <= min + 2 pi, so a range crossing the seam 0 = 2 pi runs past
 /// 2 pi: theta in [7 pi / 4, 9 pi / 4] is the outer band around the equator; max = min + 2 pi
 /// keeps every angle. Both ends are included. A ray through a removed part goes on to the next
@@ -41,10 +41,10 @@ public:
 
 private:
     Torus torus_;
-    AzimuthRange phi_range_;
+    AngleRange phi_range_;
     /// theta = atan2(y, rho - R) is the azimuth of the point (y, rho - R), so the same class
     /// serves around the tube.
-    AzimuthRange theta_range_;
+    AngleRange theta_range_;
     Aabb bounds_;
 };
 
