@@ -883,9 +883,10 @@ Expectation scan_stl(std::istream& in, std::uintmax_t file_size) {
         in.seekg(0);
         scan_stl_ascii(in, expect);
     } else {
-        problem("neither ASCII STL (no 'solid' at the start) nor binary STL: the header declares " +
-                std::to_string(facets) + " facets, which take " + std::to_string(binary_size) +
-                " bytes, but the file has " + std::to_string(file_size));
+        problem("not a binary STL of the size its header promises (" + std::to_string(facets) +
+                " facets take " + std::to_string(binary_size) + " bytes, the file has " +
+                std::to_string(file_size) +
+                ": truncated or corrupt), and not an ASCII STL (no 'solid' at the start)");
     }
     return expect;
 }
@@ -1348,7 +1349,7 @@ MeshReport validate_mesh(TriangleMeshData& mesh) {
     triangles.resize(kept);
     triangles.shrink_to_fit();
     report.triangles = kept;
-    require(kept > 0, kWhat, "triangles", "to include one of non-zero area", 0);
+    require(kept > 0, kWhat, "count of triangles with non-zero area", "> 0", kept);
 
     // Angle-weighted vertex normals: each triangle adds its unit normal times its angle at the
     // vertex, so the result does not depend on how the surface around it is triangulated.
@@ -1492,6 +1493,7 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
         triangulate(polygon, mesh.vertices, mesh.triangles);
     }
     importer = RecordingImporter();
+    const std::size_t triangle_count = mesh.triangles.size();
     try {
         MeshReport validation = validate_mesh(mesh);
         validation.format = report.format;
@@ -1501,10 +1503,11 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
         validation.triangulated_faces = report.triangulated_faces;
         validation.warnings = std::move(report.warnings);
         report = std::move(validation);
-    } catch (const InvalidParameter& invalid) {
+    } catch (const InvalidParameter&) {
         // Vertices and indices were checked above; what validation can still reject is a mesh
         // whose every triangle has zero area.
-        fail(std::string("no triangle of non-zero area (") + invalid.what() + ")");
+        fail("no triangle of non-zero area: all " + std::to_string(triangle_count) +
+             " are degenerate");
     }
     if (report_out != nullptr) *report_out = std::move(report);
     return mesh;
