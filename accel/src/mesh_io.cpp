@@ -118,15 +118,22 @@ bool parse_integer(std::string_view token, long long& value) {
     return error == std::errc() && end == token.data() + token.size();
 }
 
+/// Names one element of a file ("vertex 3", "face 0"), built only when a message needs it.
+struct Element {
+    const char* kind;
+    std::size_t index;
+    std::string name() const { return std::string(kind) + " " + std::to_string(index); }
+};
+
 /// A coordinate token: must be a finite float.
-float coordinate(std::string_view token, std::size_t line, const std::string& element) {
+float coordinate(std::string_view token, std::size_t line, const Element& element) {
     float value;
     if (!parse_float(token, value)) {
-        problem_at_line(line, element + " has coordinate " + shown(token) +
+        problem_at_line(line, element.name() + " has coordinate " + shown(token) +
                                   ", which is not a number in float range");
     }
     if (!std::isfinite(value)) {
-        problem_at_line(line, element + " has a non-finite coordinate " + shown(token));
+        problem_at_line(line, element.name() + " has a non-finite coordinate " + shown(token));
     }
     return value;
 }
@@ -185,9 +192,9 @@ std::string face_name(std::size_t index) {
 
 /// A face corner index read from the file (0-based after any conversion): must name a vertex.
 void check_corner(long long index, std::size_t vertex_count, std::size_t line,
-                  const std::string& face) {
+                  const Element& face) {
     if (index < 0 || static_cast<unsigned long long>(index) >= vertex_count) {
-        problem_at_line(line, face + " refers to vertex " + std::to_string(index) +
+        problem_at_line(line, face.name() + " refers to vertex " + std::to_string(index) +
                                   ", but the file has " + std::to_string(vertex_count) +
                                   " vertices");
     }
@@ -246,7 +253,7 @@ Expectation scan_off(std::istream& in) {
             problem_at_line(lines.number(), vertex_name(v) + " has fewer than 3 coordinates");
         }
         for (int axis = 0; axis < 3; ++axis)
-            coordinate(tokens[axis], lines.number(), vertex_name(v));
+            coordinate(tokens[axis], lines.number(), Element{"vertex", v});
         for (std::size_t i = 3; i < tokens.size(); ++i) {
             float ignored;
             if (!parse_float(tokens[i], ignored)) {
@@ -284,7 +291,7 @@ Expectation scan_off(std::istream& in) {
                 problem_at_line(lines.number(), face_name(f) + " has corner " +
                                                     shown(tokens[k + 1]) + ", not an index");
             }
-            check_corner(index, vertex_count, lines.number(), face_name(f));
+            check_corner(index, vertex_count, lines.number(), Element{"face", f});
             corners.push_back(index);
         }
         expect_face(expect, corners, false);
@@ -339,26 +346,26 @@ Expectation scan_obj(std::istream& in) {
             problem_at_line(lines.number(), "line continuations are not supported");
         const std::string_view keyword = tokens[0];
         if (keyword == "v") {
-            const std::string name = vertex_name(vertices);
+            const Element id{"vertex", vertices};
             if (tokens.size() < 4)
-                problem_at_line(lines.number(), name + " has fewer than 3 coordinates");
-            for (int axis = 0; axis < 3; ++axis) coordinate(tokens[axis + 1], lines.number(), name);
+                problem_at_line(lines.number(), id.name() + " has fewer than 3 coordinates");
+            for (int axis = 0; axis < 3; ++axis) coordinate(tokens[axis + 1], lines.number(), id);
             ++vertices;
         } else if (keyword == "vt") {
             ++texture_coordinates;
         } else if (keyword == "vn") {
             ++normals;
         } else if (keyword == "f") {
-            const std::string name = face_name(face);
+            const Element id{"face", face};
             if (tokens.size() < 4) {
-                problem_at_line(lines.number(),
-                                name + " has " + std::to_string(tokens.size() - 1) + " corners");
+                problem_at_line(lines.number(), id.name() + " has " +
+                                                    std::to_string(tokens.size() - 1) + " corners");
             }
             corners.clear();
             for (std::size_t k = 1; k < tokens.size(); ++k) {
                 long long parts[3];
                 if (!split_obj_corner(tokens[k], parts)) {
-                    problem_at_line(lines.number(), name + " has corner " + shown(tokens[k]) +
+                    problem_at_line(lines.number(), id.name() + " has corner " + shown(tokens[k]) +
                                                         ", not v, v/vt, v//vn or v/vt/vn");
                 }
                 const std::size_t counts[3] = {vertices, texture_coordinates, normals};
@@ -367,15 +374,17 @@ Expectation scan_obj(std::istream& in) {
                     long long& index = parts[part];
                     if (index == 0) {
                         if (part == 0)
-                            problem_at_line(lines.number(),
-                                            name + " refers to vertex 0 (OBJ indices start at 1)");
+                            problem_at_line(
+                                lines.number(),
+                                id.name() + " refers to vertex 0 (OBJ indices start at 1)");
                         continue;
                     }
                     if (index < 0) {
                         index += static_cast<long long>(counts[part]);
                         if (index < 0) {
-                            problem_at_line(lines.number(), name + " has relative " + what[part] +
-                                                                " index " + shown(tokens[k]) +
+                            problem_at_line(lines.number(), id.name() + " has relative " +
+                                                                what[part] + " index " +
+                                                                shown(tokens[k]) +
                                                                 " before the first " + what[part]);
                         }
                     } else {
@@ -657,9 +666,9 @@ void scan_ply_binary(std::istream& in, const PlyHeader& header, Expectation& exp
     for (const PlyElement& element : header.elements) {
         const std::size_t vertex_count = expect.vertices;
         for (std::size_t r = 0; r < element.count; ++r) {
-            const std::string name = element.name + " " + std::to_string(r);
+            const Element id{element.name.c_str(), r};
             auto truncated = [&]() {
-                problem("truncated: the file ends inside " + name + " (the header, line " +
+                problem("truncated: the file ends inside " + id.name() + " (the header, line " +
                         std::to_string(element.line) + ", declares " +
                         std::to_string(element.count) + ") at byte " +
                         std::to_string(bytes.position()));
@@ -670,7 +679,7 @@ void scan_ply_binary(std::istream& in, const PlyHeader& header, Expectation& exp
                         truncated();
                     if (is_coordinate(element, property) &&
                         !std::isfinite(float(decode(value, property.type, swap)))) {
-                        problem(name + " has a non-finite coordinate " + property.name);
+                        problem(id.name() + " has a non-finite coordinate " + property.name);
                     }
                     continue;
                 }
@@ -679,7 +688,7 @@ void scan_ply_binary(std::istream& in, const PlyHeader& header, Expectation& exp
                 const double count = decode(value, property.count_type, swap);
                 const bool indices = is_index_list(element, property);
                 if (count < 0 || (indices && count < 3)) {
-                    problem(name + " has a list of " +
+                    problem(id.name() + " has a list of " +
                             std::to_string(static_cast<long long>(count)) + " " + property.name);
                 }
                 corners.clear();
@@ -689,7 +698,7 @@ void scan_ply_binary(std::istream& in, const PlyHeader& header, Expectation& exp
                     if (!indices) continue;
                     const auto index = static_cast<long long>(decode(value, property.type, swap));
                     if (index < 0 || static_cast<std::size_t>(index) >= vertex_count) {
-                        problem(name + " refers to vertex " + std::to_string(index) +
+                        problem(id.name() + " refers to vertex " + std::to_string(index) +
                                 ", but the file has " + std::to_string(vertex_count) + " vertices");
                     }
                     corners.push_back(index);
@@ -710,9 +719,9 @@ void scan_ply_ascii(std::istream& in, const PlyHeader& header, Expectation& expe
     std::vector<long long> corners;
     for (const PlyElement& element : header.elements) {
         for (std::size_t r = 0; r < element.count; ++r) {
-            const std::string name = element.name + " " + std::to_string(r);
+            const Element id{element.name.c_str(), r};
             if (!lines.next_nonblank()) {
-                problem("truncated: the file ends before " + name + " (the header, line " +
+                problem("truncated: the file ends before " + id.name() + " (the header, line " +
                         std::to_string(element.line) + ", declares " +
                         std::to_string(element.count) + ")");
             }
@@ -720,44 +729,45 @@ void scan_ply_ascii(std::istream& in, const PlyHeader& header, Expectation& expe
             const auto& tokens = lines.tokens();
             std::size_t next = 0;
             auto take = [&]() -> std::string_view {
-                if (next == tokens.size()) problem_at_line(line, name + " has too few values");
+                if (next == tokens.size()) problem_at_line(line, id.name() + " has too few values");
                 return tokens[next++];
             };
             for (const PlyProperty& property : element.properties) {
                 if (!property.is_list) {
                     const std::string_view token = take();
                     if (is_coordinate(element, property)) {
-                        coordinate(token, line, name);
+                        coordinate(token, line, id);
                     } else {
                         float ignored;
                         if (!parse_float(token, ignored))
-                            problem_at_line(line, name + " has " + shown(token) + ", not a number");
+                            problem_at_line(line,
+                                            id.name() + " has " + shown(token) + ", not a number");
                     }
                     continue;
                 }
                 long long count;
                 const std::string_view count_token = take();
                 if (!parse_integer(count_token, count) || count < 0) {
-                    problem_at_line(line, name + " has list size " + shown(count_token));
+                    problem_at_line(line, id.name() + " has list size " + shown(count_token));
                 }
                 const bool indices = is_index_list(element, property);
                 if (indices && count < 3)
-                    problem_at_line(line, name + " has " + std::to_string(count) + " corners");
+                    problem_at_line(line, id.name() + " has " + std::to_string(count) + " corners");
                 corners.clear();
                 for (long long k = 0; k < count; ++k) {
                     const std::string_view token = take();
                     if (!indices) continue;
                     long long index;
                     if (!parse_integer(token, index))
-                        problem_at_line(line,
-                                        name + " has corner " + shown(token) + ", not an index");
-                    check_corner(index, expect.vertices, line, name);
+                        problem_at_line(
+                            line, id.name() + " has corner " + shown(token) + ", not an index");
+                    check_corner(index, expect.vertices, line, id);
                     corners.push_back(index);
                 }
                 if (indices) expect_face(expect, corners, false);
             }
             if (next != tokens.size())
-                problem_at_line(line, name + " has more values than its properties");
+                problem_at_line(line, id.name() + " has more values than its properties");
         }
     }
     if (lines.next_nonblank()) {
@@ -837,15 +847,15 @@ void scan_stl_ascii(std::istream& in, Expectation& expect) {
         if (keyword != "facet")
             problem_at_line(lines.number(),
                             "expected 'facet' or 'endsolid', found " + shown(keyword));
-        const std::string name = "facet " + std::to_string(facet);
+        const Element id{"facet", facet};
         expect_line("outer", "'outer loop'");
         float corners[9];
         for (int k = 0; k < 3; ++k) {
-            expect_line("vertex", "'vertex' " + std::to_string(k + 1) + " of " + name);
+            expect_line("vertex", "'vertex' " + std::to_string(k + 1) + " of " + id.name());
             if (lines.tokens().size() != 4)
-                problem_at_line(lines.number(), name + " has a vertex without 3 coordinates");
+                problem_at_line(lines.number(), id.name() + " has a vertex without 3 coordinates");
             for (int axis = 0; axis < 3; ++axis) {
-                corners[3 * k + axis] = coordinate(lines.tokens()[axis + 1], lines.number(), name);
+                corners[3 * k + axis] = coordinate(lines.tokens()[axis + 1], lines.number(), id);
             }
         }
         expect_line("endloop", "'endloop' (OpenMesh reads triangles only)");
@@ -1156,15 +1166,17 @@ MeshReport validate_mesh(TriangleMeshData& mesh) {
     auto& triangles = mesh.triangles;
     const std::size_t vertex_count = vertices.size();
     for (std::size_t v = 0; v < vertex_count; ++v) {
-        require(vertices[v].allFinite(), kWhat, vertex_name(v), "finite", vertices[v]);
+        if (!vertices[v].allFinite()) require(false, kWhat, vertex_name(v), "finite", vertices[v]);
     }
     require(!triangles.empty(), kWhat, "triangles", "not empty", 0);
     require(vertex_count < kNone && triangles.size() < (std::size_t{1} << 30), kWhat, "mesh size",
             "below 2^32 vertices and 2^30 triangles", triangles.size());
     for (std::size_t f = 0; f < triangles.size(); ++f) {
         for (std::uint32_t index : triangles[f]) {
-            require(index < vertex_count, kWhat, "triangle " + std::to_string(f),
-                    "indices below the vertex count " + std::to_string(vertex_count), index);
+            if (index >= vertex_count) {
+                require(false, kWhat, "triangle " + std::to_string(f),
+                        "indices below the vertex count " + std::to_string(vertex_count), index);
+            }
         }
     }
     MeshReport report;
