@@ -38,6 +38,10 @@ struct BoxFile {
     std::size_t triangulated;
 };
 
+void PrintTo(const BoxFile& file, std::ostream* out) {
+    *out << file.name;
+}
+
 class BoxFixture : public ::testing::TestWithParam<BoxFile> {};
 
 TEST_P(BoxFixture, LoadsWithTheRightCountsAndGeometry) {
@@ -133,6 +137,10 @@ struct MalformedFile {
     const char* name;
     std::vector<const char*> expected;  // substrings of the message
 };
+
+void PrintTo(const MalformedFile& file, std::ostream* out) {
+    *out << file.name;
+}
 
 class Malformed : public ::testing::TestWithParam<MalformedFile> {};
 
@@ -401,6 +409,10 @@ struct RealMesh {
     bool closed;
     int genus;  // of the closed ones: handles (the elephants' tusks and trunk make 3)
 };
+
+void PrintTo(const RealMesh& mesh, std::ostream* out) {
+    *out << mesh.name;
+}
 
 class RealMeshes : public ::testing::TestWithParam<RealMesh> {};
 
