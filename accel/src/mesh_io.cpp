@@ -7,7 +7,6 @@
 #include <OpenMesh/Core/IO/reader/OFFReader.hh>
 #include <OpenMesh/Core/IO/reader/PLYReader.hh>
 #include <OpenMesh/Core/IO/reader/STLReader.hh>
-#include <OpenMesh/Core/System/omstream.hh>
 
 #include <algorithm>
 #include <bit>
@@ -15,14 +14,16 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <limits>
-#include <mutex>
 #include <span>
 #include <sstream>
+#include <streambuf>
 #include <string_view>
 #include <system_error>
 
 #include "csgrt/core/error.h"
+#include "openmesh_session.h"
 
 namespace csgrt {
 
@@ -30,7 +31,6 @@ namespace {
 
 using Triangle = std::array<std::uint32_t, 3>;
 
-// ---------------------------------------------------------------------------------------------
 // Errors and text parsing
 
 /// Thrown by the format scans; load_mesh prefixes the file name.
@@ -138,7 +138,6 @@ float coordinate(std::string_view token, std::size_t line, const Element& elemen
     return value;
 }
 
-// ---------------------------------------------------------------------------------------------
 // What a structural scan expects OpenMesh to deliver
 
 /// What the independent scan of a file found; OpenMesh's result must agree with it.
@@ -200,7 +199,6 @@ void check_corner(long long index, std::size_t vertex_count, std::size_t line,
     }
 }
 
-// ---------------------------------------------------------------------------------------------
 // OFF
 
 /// Checks an ASCII OFF file the way OpenMesh's reader consumes it: the keyword on line 1, the
@@ -304,7 +302,6 @@ Expectation scan_off(std::istream& in) {
     return expect;
 }
 
-// ---------------------------------------------------------------------------------------------
 // OBJ
 
 /// Splits an OBJ face corner "v", "v/vt", "v//vn" or "v/vt/vn" into its three indices (0 when
@@ -416,7 +413,6 @@ Expectation scan_obj(std::istream& in) {
     return expect;
 }
 
-// ---------------------------------------------------------------------------------------------
 // Binary input
 
 /// Buffered reads from a binary stream, counting the bytes consumed.
@@ -456,7 +452,6 @@ private:
     std::uint64_t position_ = 0;
 };
 
-// ---------------------------------------------------------------------------------------------
 // PLY
 
 enum class PlyFormat { kAscii, kLittleEndian, kBigEndian };
@@ -791,7 +786,6 @@ Expectation scan_ply(std::istream& in) {
     return expect;
 }
 
-// ---------------------------------------------------------------------------------------------
 // STL
 
 /// Counts a facet; OpenMesh's STL reader merges equal corners and drops facets whose corners
@@ -901,7 +895,6 @@ Expectation scan_stl(std::istream& in, std::uintmax_t file_size) {
     return expect;
 }
 
-// ---------------------------------------------------------------------------------------------
 // OpenMesh
 
 /// Receives what an OpenMesh reader parses, without building a half-edge mesh (which would
@@ -988,65 +981,6 @@ public:
     std::size_t n_edges() const override { return 0; }
 };
 
-/// OpenMesh's reader modules keep per-read state in singletons, so reads are serialised.
-std::mutex& openmesh_mutex() {
-    static std::mutex mutex;
-    return mutex;
-}
-
-/// Reroutes OpenMesh's omerr, omlog and omout streams into a string for its lifetime, so
-/// loading prints nothing and the messages can go into errors and reports.
-class CapturedOpenMeshOutput {
-public:
-    CapturedOpenMeshOutput() {
-        errors_to_cerr_ = omerr().disconnect(std::cerr);
-        log_to_clog_ = omlog().disconnect(std::clog);
-        out_to_cout_ = omout().disconnect(std::cout);
-        omerr().connect(captured_);
-        omlog().connect(captured_);
-        omout().connect(captured_);
-    }
-    ~CapturedOpenMeshOutput() {
-        omerr().flush();
-        omlog().flush();
-        omout().flush();
-        omerr().disconnect(captured_);
-        omlog().disconnect(captured_);
-        omout().disconnect(captured_);
-        if (errors_to_cerr_) omerr().connect(std::cerr);
-        if (log_to_clog_) omlog().connect(std::clog);
-        if (out_to_cout_) omout().connect(std::cout);
-    }
-    CapturedOpenMeshOutput(const CapturedOpenMeshOutput&) = delete;
-    CapturedOpenMeshOutput& operator=(const CapturedOpenMeshOutput&) = delete;
-
-    /// The messages so far, one per line, without blank lines.
-    std::vector<std::string> messages() {
-        omerr().flush();
-        omlog().flush();
-        omout().flush();
-        std::vector<std::string> lines;
-        std::istringstream text(captured_.str());
-        for (std::string line; std::getline(text, line);) {
-            const std::size_t start = line.find_first_not_of(" \t\r");
-            if (start != std::string::npos) lines.push_back(line.substr(start));
-        }
-        return lines;
-    }
-
-private:
-    std::ostringstream captured_;
-    bool errors_to_cerr_ = false, log_to_clog_ = false, out_to_cout_ = false;
-};
-
-std::string joined(const std::vector<std::string>& messages) {
-    std::string text;
-    for (const std::string& message : messages)
-        text.append(text.empty() ? "" : "; ").append(message);
-    return text;
-}
-
-// ---------------------------------------------------------------------------------------------
 // Triangulation
 
 /// Splits a polygon into triangles by ear clipping in the plane of its Newell normal, keeping
@@ -1126,7 +1060,6 @@ void triangulate(std::span<const std::uint32_t> polygon,
     triangles.push_back({polygon[remaining[0]], polygon[remaining[1]], polygon[remaining[2]]});
 }
 
-// ---------------------------------------------------------------------------------------------
 // Validation
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
@@ -1440,24 +1373,16 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
     // The file is well formed; OpenMesh parses it, and must deliver what the scan counted.
     RecordingImporter importer;
     {
-        std::lock_guard lock(openmesh_mutex());
-        CapturedOpenMeshOutput output;
+        detail::OpenMeshSession session;
         OpenMesh::IO::BaseReader* reader = nullptr;
         if (extension == ".off") reader = &OpenMesh::IO::OFFReader();
         if (extension == ".obj") reader = &OpenMesh::IO::OBJReader();
         if (extension == ".ply") reader = &OpenMesh::IO::PLYReader();
         if (extension == ".stl") reader = &OpenMesh::IO::STLReader();
         // can_u_read also parses the header into the reader's options, which read() uses.
-        if (!reader->can_u_read(name)) {
-            fail("OpenMesh's " + report.format + " reader does not accept it" +
-                 (output.messages().empty() ? "" : ": " + joined(output.messages())));
-        }
+        if (!reader->can_u_read(name)) fail("OpenMesh's " + report.format + " reader refuses it");
         OpenMesh::IO::Options options;
-        const bool ok = reader->read(name, importer, options);
-        report.warnings = output.messages();
-        if (!ok)
-            fail("OpenMesh could not read it" +
-                 (report.warnings.empty() ? "" : ": " + joined(report.warnings)));
+        if (!reader->read(name, importer, options)) fail("OpenMesh could not read it");
     }
     const std::size_t face_count = importer.face_count();
     const std::size_t expected_faces = expect.file_faces - expect.dropped_faces;
@@ -1506,6 +1431,10 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
     }
     importer = RecordingImporter();
     const std::size_t triangle_count = mesh.triangles.size();
+    if (triangle_count >= (std::size_t{1} << 30) || mesh.vertices.size() >= kNone) {
+        fail("too large: " + std::to_string(triangle_count) + " triangles (at most 2^30 - 1) and " +
+             std::to_string(mesh.vertices.size()) + " vertices (at most 2^32 - 2)");
+    }
     try {
         MeshReport validation = validate_mesh(mesh);
         validation.format = report.format;
@@ -1513,7 +1442,6 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
         validation.faces = report.faces;
         validation.dropped_faces = report.dropped_faces;
         validation.triangulated_faces = report.triangulated_faces;
-        validation.warnings = std::move(report.warnings);
         report = std::move(validation);
     } catch (const InvalidParameter&) {
         // Vertices and indices were checked above; what validation can still reject is a mesh

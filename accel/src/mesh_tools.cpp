@@ -1,18 +1,22 @@
 #include "csgrt/accel/mesh_tools.h"
 
+// OpenMesh's properties default-construct their vectors uninitialised by design; GCC's
+// -Wmaybe-uninitialized flags that inside its headers at -O1 (the asan preset).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#include <OpenMesh/Core/System/omstream.hh>
 #include <OpenMesh/Tools/Decimater/DecimaterT.hh>
 #include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
+#pragma GCC diagnostic pop
 
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <string>
 
 #include "csgrt/core/error.h"
+#include "openmesh_session.h"
 
 namespace csgrt {
 
@@ -25,28 +29,6 @@ struct DoubleTraits : OpenMesh::DefaultTraits {
 };
 using HalfEdgeMesh = OpenMesh::TriMesh_ArrayKernelT<DoubleTraits>;
 
-/// Silences OpenMesh's error stream for its lifetime: add_face prints "complex edge" for every
-/// face it refuses, and the refusal is reported as an exception instead.
-class SilencedOpenMeshErrors {
-public:
-    SilencedOpenMeshErrors() : lock_(mutex()), was_enabled_(omerr().is_enabled()) {
-        omerr().disable();
-    }
-    ~SilencedOpenMeshErrors() {
-        if (was_enabled_) omerr().enable();
-    }
-    SilencedOpenMeshErrors(const SilencedOpenMeshErrors&) = delete;
-    SilencedOpenMeshErrors& operator=(const SilencedOpenMeshErrors&) = delete;
-
-private:
-    static std::mutex& mutex() {
-        static std::mutex shared;
-        return shared;
-    }
-    std::lock_guard<std::mutex> lock_;
-    bool was_enabled_;
-};
-
 /// The referenced vertices and the triangles of `mesh` as a half-edge mesh.
 HalfEdgeMesh to_half_edges(const TriangleMeshData& mesh, std::string_view what) {
     constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
@@ -55,7 +37,8 @@ HalfEdgeMesh to_half_edges(const TriangleMeshData& mesh, std::string_view what) 
     result.reserve(static_cast<unsigned>(mesh.vertices.size()),
                    static_cast<unsigned>(3 * mesh.triangles.size() / 2),
                    static_cast<unsigned>(mesh.triangles.size()));
-    SilencedOpenMeshErrors silenced;
+    // add_face prints "complex edge" for each face it refuses; the refusal is thrown instead.
+    detail::OpenMeshSession session;
     std::vector<HalfEdgeMesh::VertexHandle> corners(3);
     for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
         for (int k = 0; k < 3; ++k) {

@@ -75,16 +75,15 @@ struct MeshReport {
     bool is_closed = false;
     /// Enclosed volume after orientation (closed meshes; 0 otherwise).
     double volume = 0.0;
-    /// What OpenMesh printed while reading (it is silenced and its messages kept here).
-    std::vector<std::string> warnings;
 };
 
 /// Reads an OFF, OBJ, PLY (ascii or binary) or STL (ascii or binary) file through OpenMesh's
 /// readers, after checking the file's structure independently (OpenMesh accepts truncated and
 /// miscounted files silently), then triangulates polygons, validates and repairs the result
 /// with `validate_mesh`. Coordinates arrive in float, as OpenMesh 9's readers deliver them.
-/// Throws MeshError naming the file and the problem; never returns partial data. Thread-safe
-/// (OpenMesh's readers are not, so reads are serialised).
+/// OpenMesh prints nothing meanwhile (its message streams are disabled). Throws MeshError
+/// naming the file and the problem; never returns partial data. Thread-safe (OpenMesh's
+/// readers are not, so the OpenMesh part of loads is serialised).
 TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report = nullptr);
 
 /// Validates and repairs a mesh made in memory by the rules load_mesh applies after reading:
