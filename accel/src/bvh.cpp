@@ -265,12 +265,6 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             detail::BuildPrimitive& primitive = primitives[i];
             pad_box(set.bounds(i), primitive);
-            const Point3 centroid = set.centroid(i);
-            for (int axis = 0; axis < 3; ++axis) {
-                // Unbounded shapes have no centroid; any finite value bins them somewhere.
-                const double c = std::isfinite(centroid[axis]) ? centroid[axis] : 0.0;
-                primitive.centroid[axis] = static_cast<float>(std::clamp(c, -1e30, 1e30));
-            }
             primitive.index = static_cast<std::uint32_t>(i);
         }
     };

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "bvh_simd.h"
 #include "csgrt/accel/bvh_build.h"
 
 namespace csgrt::detail {
@@ -21,90 +22,113 @@ constexpr int kMaxBins = 256;
 constexpr std::uint32_t kParallelSubtree = 4096;
 constexpr std::uint32_t kParallelBinning = 1u << 16;
 
-/// A float box; trivially constructible so that arrays of bins cost nothing until used.
+/// A float box in two SIMD registers (the fourth lane is unused).
 struct Box {
-    float lower[3];
-    float upper[3];
+    Float4 lower;
+    Float4 upper;
 
     static Box empty() {
-        return {{kInfinityFloat, kInfinityFloat, kInfinityFloat},
-                {-kInfinityFloat, -kInfinityFloat, -kInfinityFloat}};
+        return {Float4::broadcast(kInfinityFloat), Float4::broadcast(-kInfinityFloat)};
     }
-
-    void extend(const float* low, const float* high) {
-        for (int axis = 0; axis < 3; ++axis) {
-            lower[axis] = std::min(lower[axis], low[axis]);
-            upper[axis] = std::max(upper[axis], high[axis]);
-        }
+    static Box of(const BuildPrimitive& p) {
+        return {Float4::load(p.lower), Float4::load(p.upper)};
     }
-    void extend(const Box& box) { extend(box.lower, box.upper); }
+    // The new value is the first operand: a NaN in it (the centre of an unbounded box) is
+    // ignored rather than spread.
+    void extend(const Box& box) {
+        lower = min(box.lower, lower);
+        upper = max(box.upper, upper);
+    }
+    void extend(Float4 point) {
+        lower = min(point, lower);
+        upper = max(point, upper);
+    }
+    void store(float* low, float* high) const {
+        float l[4], h[4];
+        lower.store(l);
+        upper.store(h);
+        std::copy_n(l, 3, low);
+        std::copy_n(h, 3, high);
+    }
     /// Half the surface area, in double so that large boxes do not overflow; the SAH only
     /// uses ratios of areas.
     double half_area() const {
-        if (!(lower[0] <= upper[0] && lower[1] <= upper[1] && lower[2] <= upper[2])) return 0.0;
-        const double x = double(upper[0]) - lower[0], y = double(upper[1]) - lower[1],
-                     z = double(upper[2]) - lower[2];
+        float l[4], h[4];
+        lower.store(l);
+        upper.store(h);
+        if (!(l[0] <= h[0] && l[1] <= h[1] && l[2] <= h[2])) return 0.0;
+        const double x = double(h[0]) - l[0], y = double(h[1]) - l[1], z = double(h[2]) - l[2];
         return x * y + y * z + z * x;
     }
 };
 
-/// The boxes of a range's primitives and of their centroids.
-struct RangeBounds {
-    Box box = Box::empty();
-    Box centroids = Box::empty();
+/// Twice the centre of a primitive's box: binning only needs it up to scale.
+Float4 doubled_centroid(const BuildPrimitive& p) {
+    return Float4::load(p.lower) + Float4::load(p.upper);
+}
 
-    void add(const BuildPrimitive& primitive) {
-        box.extend(primitive.lower, primitive.upper);
-        centroids.extend(primitive.centroid, primitive.centroid);
-    }
-    void join(const RangeBounds& other) {
-        box.extend(other.box);
-        centroids.extend(other.centroids);
-    }
+/// A range of primitives with its box and the box of its (doubled) centroids.
+struct Range {
+    std::uint32_t begin, end;
+    Box box;
+    Box centroids;
 };
 
-/// Maps a centroid coordinate to its bin along one axis. The same arithmetic is used when
+/// Maps doubled centroids to bins, on all three axes at once. The same arithmetic is used when
 /// binning and when partitioning, so both agree on every primitive.
 struct BinMapping {
-    float origin[3];
-    float scale[3];
-    int bins;
+    Float4 origin, scale, last;
+    float scales[4];
 
-    BinMapping(const Box& centroids, int bin_count) : bins(bin_count) {
+    BinMapping(const Box& centroids, int bin_count) {
+        float l[4], h[4];
+        centroids.lower.store(l);
+        centroids.upper.store(h);
         for (int axis = 0; axis < 3; ++axis) {
-            origin[axis] = centroids.lower[axis];
             // A zero, infinite or denormal extent gives a useless or non-finite scale: such
             // an axis is not binned.
-            const float extent = centroids.upper[axis] - centroids.lower[axis];
+            const float extent = h[axis] - l[axis];
             const float s = float(bin_count) / extent;
-            scale[axis] = extent > 0.0f && std::isfinite(s) && s > 0.0f ? s : 0.0f;
+            scales[axis] = extent > 0.0f && std::isfinite(s) && s > 0.0f ? s : 0.0f;
+            if (!std::isfinite(l[axis])) l[axis] = 0.0f;
         }
+        l[3] = 0.0f;
+        scales[3] = 0.0f;
+        origin = Float4::load(l);
+        scale = Float4::load(scales);
+        last = Float4::broadcast(float(bin_count - 1));
     }
-    int bin(int axis, float coordinate) const {
-        const int b = static_cast<int>((coordinate - origin[axis]) * scale[axis]);
-        return std::clamp(b, 0, bins - 1);
+    /// The bins of a primitive on the three axes (and a fourth, unused).
+    void bins(const BuildPrimitive& p, int* out) const {
+        // max(x, 0) returns 0 for NaN (the centre of an unbounded box) and min clamps to the
+        // last bin, so the truncation always sees a value in [0, bins - 1].
+        const Float4 position = (doubled_centroid(p) - origin) * scale;
+        min(max(position, Float4::broadcast(0.0f)), last).truncate(out);
     }
 };
 
 struct Bins {
     Box boxes[3][kMaxBins];
     std::uint32_t counts[3][kMaxBins];
+    int bin_count;
 
     /// Only the first `bin_count` bins of each axis are used (and initialised).
-    explicit Bins(int bin_count) {
+    explicit Bins(int n) : bin_count(n) {
         for (int axis = 0; axis < 3; ++axis) {
-            std::fill_n(boxes[axis], bin_count, Box::empty());
-            std::fill_n(counts[axis], bin_count, 0u);
+            std::fill_n(boxes[axis], n, Box::empty());
+            std::fill_n(counts[axis], n, 0u);
         }
     }
     void add(const BinMapping& mapping, const BuildPrimitive& primitive) {
+        alignas(16) int bin[4];
+        mapping.bins(primitive, bin);
+        const Box box = Box::of(primitive);
         for (int axis = 0; axis < 3; ++axis) {
-            const int b = mapping.bin(axis, primitive.centroid[axis]);
-            boxes[axis][b].extend(primitive.lower, primitive.upper);
-            ++counts[axis][b];
+            boxes[axis][bin[axis]].extend(box);
+            ++counts[axis][bin[axis]];
         }
     }
-    void join(const Bins& other, int bin_count) {
+    void join(const Bins& other) {
         for (int axis = 0; axis < 3; ++axis) {
             for (int b = 0; b < bin_count; ++b) {
                 boxes[axis][b].extend(other.boxes[axis][b]);
@@ -127,52 +151,58 @@ public:
     Builder(std::span<BuildPrimitive> primitives, const BvhConfig& config, BinaryBvh& tree)
         : primitives_(primitives), config_(config), tree_(tree) {}
 
-    /// Builds the subtree of primitives [begin, end) into node `node`; returns its depth.
-    int build(std::uint32_t node, std::uint32_t begin, std::uint32_t end, int depth) {
-        const std::uint32_t count = end - begin;
-        const RangeBounds bounds = range_bounds(begin, end);
-        BvhNode& target = tree_.nodes[node];
-        std::copy_n(bounds.box.lower, 3, target.lower);
-        std::copy_n(bounds.box.upper, 3, target.upper);
+    /// The box and centroid box of all primitives, for the root.
+    Range root() const {
+        Range range{0, static_cast<std::uint32_t>(primitives_.size()), Box::empty(), Box::empty()};
+        for (const BuildPrimitive& p : primitives_) {
+            range.box.extend(Box::of(p));
+            range.centroids.extend(doubled_centroid(p));
+        }
+        return range;
+    }
 
-        std::uint32_t middle = begin;
+    /// Builds the subtree of `range` into node `node`; returns its depth.
+    int build(std::uint32_t node, const Range& range, int depth) {
+        const std::uint32_t count = range.end - range.begin;
+        BvhNode& target = tree_.nodes[node];
+        range.box.store(target.lower, target.upper);
+
+        Range left, right;
+        bool split = false;
         if (count > 1 && depth < kMaxSahDepth) {
-            const Split split = find_split(begin, end, bounds);
+            const int bin_count = bins_for(count);
+            const BinMapping mapping(range.centroids, bin_count);
+            const Split best = find_split(range, mapping, bin_count);
             const double leaf_cost = config_.intersection_cost * count;
-            const double split_cost = config_.traversal_cost + config_.intersection_cost *
-                                                                   split.cost /
-                                                                   bounds.box.half_area();
-            const bool split_pays = split.axis >= 0 && split_cost < leaf_cost;
-            if (split.axis >= 0 && (split_pays || count > std::uint32_t(config_.max_leaf_size))) {
-                const BinMapping mapping(bounds.centroids, bins_for(count));
-                const auto first_right = std::partition(
-                    primitives_.begin() + begin, primitives_.begin() + end,
-                    [&](const BuildPrimitive& p) {
-                        return mapping.bin(split.axis, p.centroid[split.axis]) <= split.bin;
-                    });
-                middle = static_cast<std::uint32_t>(first_right - primitives_.begin());
+            const double split_cost = config_.traversal_cost +
+                                      config_.intersection_cost * best.cost / range.box.half_area();
+            const bool split_pays = best.axis >= 0 && split_cost < leaf_cost;
+            if (best.axis >= 0 && (split_pays || count > std::uint32_t(config_.max_leaf_size))) {
+                partition(range, mapping, best, left, right);
+                split = true;
             }
         }
-        if (middle == begin && count > std::uint32_t(config_.max_leaf_size)) {
-            middle = median_split(begin, end, bounds);
+        if (!split && count > std::uint32_t(config_.max_leaf_size)) {
+            median_split(range, left, right);
+            split = true;
         }
-        if (middle == begin || middle == end) {
-            target.offset = begin;
+        if (!split) {
+            target.offset = range.begin;
             target.count = count;
             leaves_.fetch_add(1, std::memory_order_relaxed);
             return 0;
         }
 
-        const std::uint32_t left = next_node_.fetch_add(2, std::memory_order_relaxed);
-        target.offset = left;
+        const std::uint32_t first = next_node_.fetch_add(2, std::memory_order_relaxed);
+        target.offset = first;
         target.count = 0;
         int left_depth = 0, right_depth = 0;
         if (config_.parallel && count > kParallelSubtree) {
-            tbb::parallel_invoke([&] { left_depth = build(left, begin, middle, depth + 1); },
-                                 [&] { right_depth = build(left + 1, middle, end, depth + 1); });
+            tbb::parallel_invoke([&] { left_depth = build(first, left, depth + 1); },
+                                 [&] { right_depth = build(first + 1, right, depth + 1); });
         } else {
-            left_depth = build(left, begin, middle, depth + 1);
-            right_depth = build(left + 1, middle, end, depth + 1);
+            left_depth = build(first, left, depth + 1);
+            right_depth = build(first + 1, right, depth + 1);
         }
         return 1 + std::max(left_depth, right_depth);
     }
@@ -187,59 +217,39 @@ private:
         return static_cast<int>(std::min<std::uint32_t>(config_.bins, std::max(4u, count)));
     }
 
-    RangeBounds range_bounds(std::uint32_t begin, std::uint32_t end) const {
-        auto add_range = [&](const tbb::blocked_range<std::uint32_t>& range, RangeBounds bounds) {
-            for (std::uint32_t i = range.begin(); i != range.end(); ++i) bounds.add(primitives_[i]);
-            return bounds;
-        };
-        if (!config_.parallel || end - begin < kParallelBinning) {
-            return add_range({begin, end}, RangeBounds{});
-        }
-        return tbb::parallel_reduce(tbb::blocked_range<std::uint32_t>(begin, end, 1u << 14),
-                                    RangeBounds{}, add_range,
-                                    [](RangeBounds a, const RangeBounds& b) {
-                                        a.join(b);
-                                        return a;
-                                    });
-    }
-
     /// The cheapest binned split over all three axes (axis -1 when the centroids coincide).
-    Split find_split(std::uint32_t begin, std::uint32_t end, const RangeBounds& bounds) const {
-        const int bin_count = bins_for(end - begin);
-        const BinMapping mapping(bounds.centroids, bin_count);
+    Split find_split(const Range& range, const BinMapping& mapping, int bin_count) const {
         Bins bins(bin_count);
-        if (!config_.parallel || end - begin < kParallelBinning) {
-            for (std::uint32_t i = begin; i != end; ++i) bins.add(mapping, primitives_[i]);
+        if (!config_.parallel || range.end - range.begin < kParallelBinning) {
+            for (std::uint32_t i = range.begin; i != range.end; ++i)
+                bins.add(mapping, primitives_[i]);
         } else {
             // Each task bins a chunk into its own bins; the results are summed.
             struct Body {
                 const Builder& builder;
                 const BinMapping& mapping;
-                int bin_count;
                 Bins bins;
                 Body(const Builder& b, const BinMapping& m, int n)
-                    : builder(b), mapping(m), bin_count(n), bins(n) {}
+                    : builder(b), mapping(m), bins(n) {}
                 Body(Body& other, tbb::split)
-                    : builder(other.builder),
-                      mapping(other.mapping),
-                      bin_count(other.bin_count),
-                      bins(other.bin_count) {}
-                void operator()(const tbb::blocked_range<std::uint32_t>& range) {
-                    for (std::uint32_t i = range.begin(); i != range.end(); ++i)
+                    : builder(other.builder), mapping(other.mapping), bins(other.bins.bin_count) {}
+                void operator()(const tbb::blocked_range<std::uint32_t>& chunk) {
+                    for (std::uint32_t i = chunk.begin(); i != chunk.end(); ++i)
                         bins.add(mapping, builder.primitives_[i]);
                 }
-                void join(const Body& other) { bins.join(other.bins, bin_count); }
+                void join(const Body& other) { bins.join(other.bins); }
             };
             Body body(*this, mapping, bin_count);
-            tbb::parallel_reduce(tbb::blocked_range<std::uint32_t>(begin, end, 1u << 14), body);
+            tbb::parallel_reduce(
+                tbb::blocked_range<std::uint32_t>(range.begin, range.end, 1u << 14), body);
             bins = body.bins;
         }
 
         Split best;
         double right_cost[kMaxBins];
         for (int axis = 0; axis < 3; ++axis) {
-            if (mapping.scale[axis] == 0.0f) continue;
-            // Sweep from the right, then from the left: cost of splitting after bin b is
+            if (mapping.scales[axis] == 0.0f) continue;
+            // Sweep from the right, then from the left: the cost of splitting after bin b is
             // area(left) count(left) + area(right) count(right).
             Box right = Box::empty();
             std::uint32_t right_count = 0;
@@ -261,24 +271,74 @@ private:
         return best;
     }
 
-    /// Splits [begin, end) in half by centroid along the longest centroid axis, ties (and
+    /// Moves the primitives of bins 0 .. split.bin to the front of the range, computing both
+    /// sides' boxes on the way.
+    void partition(const Range& range, const BinMapping& mapping, const Split& split, Range& left,
+                   Range& right) {
+        auto goes_left = [&](const BuildPrimitive& p) {
+            alignas(16) int bin[4];
+            mapping.bins(p, bin);
+            return bin[split.axis] <= split.bin;
+        };
+        left = {range.begin, range.begin, Box::empty(), Box::empty()};
+        right = {range.end, range.end, Box::empty(), Box::empty()};
+        BuildPrimitive* i = primitives_.data() + range.begin;
+        BuildPrimitive* j = primitives_.data() + range.end;
+        for (;;) {
+            while (i != j && goes_left(*i)) {
+                left.box.extend(Box::of(*i));
+                left.centroids.extend(doubled_centroid(*i));
+                ++i;
+            }
+            while (i != j && !goes_left(*(j - 1))) {
+                --j;
+                right.box.extend(Box::of(*j));
+                right.centroids.extend(doubled_centroid(*j));
+            }
+            if (i == j) break;
+            // *i belongs right and *(j - 1) left: exchange them and count both.
+            --j;
+            std::swap(*i, *j);
+            left.box.extend(Box::of(*i));
+            left.centroids.extend(doubled_centroid(*i));
+            ++i;
+            right.box.extend(Box::of(*j));
+            right.centroids.extend(doubled_centroid(*j));
+        }
+        left.end = right.begin = static_cast<std::uint32_t>(i - primitives_.data());
+    }
+
+    /// Splits the range in half by centroid along the longest centroid axis, ties (and
     /// coincident centroids) broken by primitive index so the halves are reproducible.
-    std::uint32_t median_split(std::uint32_t begin, std::uint32_t end, const RangeBounds& bounds) {
+    void median_split(const Range& range, Range& left, Range& right) {
+        float l[4], h[4];
+        range.centroids.lower.store(l);
+        range.centroids.upper.store(h);
         int axis = 0;
         float longest = -1.0f;
         for (int a = 0; a < 3; ++a) {
-            const float extent = bounds.centroids.upper[a] - bounds.centroids.lower[a];
+            const float extent = h[a] - l[a];
             if (extent > longest) longest = extent, axis = a;
         }
-        const std::uint32_t middle = begin + (end - begin) / 2;
-        std::nth_element(primitives_.begin() + begin, primitives_.begin() + middle,
-                         primitives_.begin() + end,
-                         [axis](const BuildPrimitive& a, const BuildPrimitive& b) {
-                             if (a.centroid[axis] != b.centroid[axis])
-                                 return a.centroid[axis] < b.centroid[axis];
-                             return a.index < b.index;
+        auto key = [axis](const BuildPrimitive& p) {
+            const float c = p.lower[axis] + p.upper[axis];
+            return std::isnan(c) ? 0.0f : c;
+        };
+        const std::uint32_t middle = range.begin + (range.end - range.begin) / 2;
+        std::nth_element(primitives_.begin() + range.begin, primitives_.begin() + middle,
+                         primitives_.begin() + range.end,
+                         [&](const BuildPrimitive& a, const BuildPrimitive& b) {
+                             const float ka = key(a), kb = key(b);
+                             return ka != kb ? ka < kb : a.index < b.index;
                          });
-        return middle;
+        left = {range.begin, middle, Box::empty(), Box::empty()};
+        right = {middle, range.end, Box::empty(), Box::empty()};
+        for (Range* side : {&left, &right}) {
+            for (std::uint32_t k = side->begin; k != side->end; ++k) {
+                side->box.extend(Box::of(primitives_[k]));
+                side->centroids.extend(doubled_centroid(primitives_[k]));
+            }
+        }
     }
 
     std::span<BuildPrimitive> primitives_;
@@ -289,12 +349,14 @@ private:
     std::atomic<std::size_t> leaves_{0};
 };
 
+double node_half_area(const BvhNode& node) {
+    const float lower[4] = {node.lower[0], node.lower[1], node.lower[2], 0.0f};
+    const float upper[4] = {node.upper[0], node.upper[1], node.upper[2], 0.0f};
+    return Box{Float4::load(lower), Float4::load(upper)}.half_area();
+}
+
 double sah_cost(const BinaryBvh& tree, const BvhConfig& config) {
-    auto half_area = [](const BvhNode& node) {
-        Box box = Box::empty();
-        box.extend(node.lower, node.upper);
-        return box.half_area();
-    };
+    auto half_area = [](const BvhNode& node) { return node_half_area(node); };
     double total = 0.0;
     for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
         if (i == 1) continue;
@@ -327,9 +389,8 @@ std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
         for (int i = 0; i < child_count; ++i) {
             const BvhNode& child = nodes[children[i]];
             if (child.is_leaf()) continue;
-            Box box = Box::empty();
-            box.extend(child.lower, child.upper);
-            if (box.half_area() > widest_area) widest_area = box.half_area(), widest = i;
+            const double area = node_half_area(child);
+            if (area > widest_area) widest_area = area, widest = i;
         }
         if (widest < 0) break;
         const std::uint32_t opened = children[widest];
@@ -386,7 +447,7 @@ BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig
     // root, the unused slot and every sibling pair.
     tree.nodes.resize(2 * primitives.size());
     Builder builder(primitives, config, tree);
-    tree.depth = builder.build(0, 0, static_cast<std::uint32_t>(primitives.size()), 0);
+    tree.depth = builder.build(0, builder.root(), 0);
     tree.nodes.resize(primitives.size() == 1 ? 1 : builder.node_count());
     tree.nodes.shrink_to_fit();
     tree.leaves = builder.leaf_count();

@@ -526,11 +526,12 @@ TEST(Bvh, ParallelAndSerialBuildsMakeTheSameTree) {
 }
 
 TEST(Bvh, PathologicalSpacingStaysWithinTheDepthBound) {
-    // Triangles at x = 2^k: SAH splits peel a few off at a time, so without the depth limit
-    // the tree would be far deeper than the traversal stack allows.
+    // Triangles at x = 3^k, binned into 2 bins: only the largest lies in the upper bin, so
+    // every binned split peels off one triangle and, without the depth limit, the tree would
+    // be 158 levels deep, beyond what the traversal stack holds.
     TestMesh mesh;
-    for (int k = -960; k <= 960; ++k) {
-        const double x = std::exp2(k / 8.0);
+    for (int k = -79; k <= 79; ++k) {
+        const double x = std::pow(3.0, k);
         const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
         mesh.vertices.insert(mesh.vertices.end(), {{x, 0, 0}, {x, 1, 0}, {x, 0, 1}});
         mesh.triangles.push_back({base, base + 1, base + 2});
@@ -540,7 +541,7 @@ TEST(Bvh, PathologicalSpacingStaysWithinTheDepthBound) {
     brute.build(set);
     for (int width : {2, 4}) {
         Bvh<TriangleSet<double>> bvh;
-        bvh.build(set, BvhConfig{.max_leaf_size = 1, .width = width});
+        bvh.build(set, BvhConfig{.bins = 2, .max_leaf_size = 1, .width = width});
         const std::string details = bvh.stats().details;
         const int depth = std::stoi(details.substr(details.find("depth ") + 6));
         EXPECT_LE(depth, detail::kMaxDepth) << details;
@@ -548,7 +549,7 @@ TEST(Bvh, PathologicalSpacingStaysWithinTheDepthBound) {
         std::vector<Ray> rays;
         test::Random random(14);
         for (int i = 0; i < 2000; ++i) {
-            const Point3 p(std::ldexp(1.0, random.integer(-122, 122)), random.uniform(0, 0.5),
+            const Point3 p(std::pow(3.0, random.uniform(-80, 80)), random.uniform(0, 0.5),
                            random.uniform(0, 0.5));
             rays.push_back(Ray{p + Vector3(0, 0, 5), Vector3(random.uniform(-1, 1), 0, -1)});
             rays.push_back(Ray{Point3(-1, p.y(), p.z()), Vector3(1, 0, 0)});

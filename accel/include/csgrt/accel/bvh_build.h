@@ -79,13 +79,14 @@ struct AlignedAllocator {
 
 namespace detail {
 
-/// What the builder knows of a primitive: a conservative float box, a representative point
-/// (for binning) and the primitive's index in its set. The builder never sees the set itself.
-struct BuildPrimitive {
+/// What the builder knows of a primitive: a conservative float box and the primitive's index
+/// in its set; it bins the box centres, as Wald (2007) does. The builder never sees the set.
+/// 32 bytes, so that each half loads as one SIMD register.
+struct alignas(16) BuildPrimitive {
     float lower[3];
-    float upper[3];
-    float centroid[3];
     std::uint32_t index;
+    float upper[3];
+    float unused = 0.0f;
 };
 
 /// A binary BVH as built: nodes (see BvhNode), the primitive indices in leaf order, and
