@@ -234,6 +234,18 @@ void pad_box(const Aabb& box, detail::BuildPrimitive& primitive) {
     }
 }
 
+/// Starts loading primitive i of the set, where the set lets us know where it is.
+template <class Set>
+void prefetch_primitive([[maybe_unused]] const Set& set, [[maybe_unused]] std::uint32_t i) {
+#if defined(__SSE2__)
+    if constexpr (requires { set.corner(std::size_t{0}, 0); }) {
+        const char* corners = reinterpret_cast<const char*>(&set.corner(i, 0));
+        _mm_prefetch(corners, _MM_HINT_T0);
+        _mm_prefetch(corners + 3 * sizeof(set.corner(i, 0)) - 1, _MM_HINT_T0);
+    }
+#endif
+}
+
 /// Stack entries: a node (binary) or a child reference (4-wide), and its entry distance.
 struct BinaryEntry {
     std::uint32_t node;
@@ -277,7 +289,6 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
 
     detail::BinaryBvh tree = detail::build_binary_bvh(primitives, config);
     primitives = {};
-    indices_ = std::move(tree.indices);
     wide_nodes_.clear();
     binary_nodes_.clear();
     if (config.width == 4) {
@@ -285,6 +296,7 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     } else {
         binary_nodes_ = std::move(tree.nodes);
     }
+    indices_ = std::move(tree.indices);
 
     stats_ = AcceleratorStats{};
     stats_.name = "bvh";
@@ -342,7 +354,7 @@ void Bvh<Set>::traverse_binary(const BoxRay& box_ray, double ray_t_max, Traversa
         const BvhNode& node = binary_nodes_[index];
         if constexpr (kCount) ++counters.nodes_visited;
         if (node.is_leaf()) {
-            if (leaf(node.offset, node.count, t_max)) return;
+            if (leaf(&indices_[node.offset], node.count, t_max)) return;
         } else {
             if constexpr (kCount) counters.boxes_tested += 2;
             float t_left, t_right;
@@ -384,13 +396,16 @@ void Bvh<Set>::traverse_wide(const BoxRay& box_ray, double ray_t_max, TraversalC
     WideEntry* top = stack;
     std::uint32_t first = 0, count = Bvh4Node::kInterior;
     alignas(16) float t_enter[4];
-    // Children that wait on the stack are fetched while the nearest one is traversed.
+    // Children that wait on the stack are fetched while the nearest one is traversed: a
+    // node's two cache lines, a one-primitive leaf's primitive, a larger leaf's indices.
     auto prefetch = [&](std::uint32_t child_first, std::uint32_t child_count) {
 #if defined(__SSE2__)
         if (child_count == Bvh4Node::kInterior) {
             const char* address = reinterpret_cast<const char*>(&wide_nodes_[child_first]);
             _mm_prefetch(address, _MM_HINT_T0);
             _mm_prefetch(address + 64, _MM_HINT_T0);
+        } else if (child_count == 1) {
+            prefetch_primitive(*set_, child_first);
         } else {
             _mm_prefetch(reinterpret_cast<const char*>(&indices_[child_first]), _MM_HINT_T0);
         }
@@ -416,6 +431,7 @@ void Bvh<Set>::traverse_wide(const BoxRay& box_ray, double ray_t_max, TraversalC
             // the nearest is on top, and take it.
             WideEntry* pushed = top;
             *top++ = WideEntry{first, count, t_enter[nearest]};
+            prefetch(first, count);
             do {
                 const int slot = std::countr_zero(mask);
                 mask &= mask - 1;
@@ -434,7 +450,9 @@ void Bvh<Set>::traverse_wide(const BoxRay& box_ray, double ray_t_max, TraversalC
         }
         if (count != Bvh4Node::kInterior) {
             if constexpr (kCount) ++counters.nodes_visited;
-            if (leaf(first, count, t_max)) return;
+            // A one-primitive leaf holds the primitive's index itself.
+            const std::uint32_t* primitives = count == 1 ? &first : &indices_[first];
+            if (leaf(primitives, count, t_max)) return;
         }
         // Skip entries whose subtree starts beyond the nearest hit found since they were
         // pushed.
@@ -456,17 +474,18 @@ bool Bvh<Set>::intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& s
     HitRecord best;
     best.t = ray.t_max;
     bool found = false;
-    traverse<kCount>(ray, counters, [&](std::uint32_t first, std::uint32_t count, float& t_max) {
-        if constexpr (kCount) counters.primitives_tested += count;
-        bool hit = false;
-        for (std::uint32_t i = first; i != first + count; ++i)
-            hit |= set_->intersect(indices_[i], prepared, best);
-        if (hit) {
-            found = true;
-            t_max = round_up(best.t);
-        }
-        return false;
-    });
+    traverse<kCount>(ray, counters,
+                     [&](const std::uint32_t* primitives, std::uint32_t count, float& t_max) {
+                         if constexpr (kCount) counters.primitives_tested += count;
+                         bool hit = false;
+                         for (std::uint32_t i = 0; i != count; ++i)
+                             hit |= set_->intersect(primitives[i], prepared, best);
+                         if (hit) {
+                             found = true;
+                             t_max = round_up(best.t);
+                         }
+                         return false;
+                     });
     if (found) record = best;
     return found;
 }
@@ -478,13 +497,14 @@ bool Bvh<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
     if (set_ == nullptr || !is_valid(ray)) return false;
     const auto prepared = set_->prepare(ray, scratch);
     bool occluded = false;
-    traverse<kCount>(ray, counters, [&](std::uint32_t first, std::uint32_t count, float&) {
-        for (std::uint32_t i = first; i != first + count; ++i) {
-            if constexpr (kCount) ++counters.primitives_tested;
-            if (set_->occluded(indices_[i], prepared)) return occluded = true;
-        }
-        return false;
-    });
+    traverse<kCount>(ray, counters,
+                     [&](const std::uint32_t* primitives, std::uint32_t count, float&) {
+                         for (std::uint32_t i = 0; i != count; ++i) {
+                             if constexpr (kCount) ++counters.primitives_tested;
+                             if (set_->occluded(primitives[i], prepared)) return occluded = true;
+                         }
+                         return false;
+                     });
     return occluded;
 }
 
@@ -517,11 +537,11 @@ void Bvh<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits, QueryScrat
     if (set_ == nullptr || !is_valid(ray)) return;
     const auto prepared = set_->prepare(ray, scratch);
     TraversalCounters unused;
-    traverse<false>(ray, unused, [&](std::uint32_t first, std::uint32_t count, float&) {
-        for (std::uint32_t i = first; i != first + count; ++i) {
+    traverse<false>(ray, unused, [&](const std::uint32_t* primitives, std::uint32_t count, float&) {
+        for (std::uint32_t i = 0; i != count; ++i) {
             HitRecord record;
             record.t = ray.t_max;
-            if (set_->intersect(indices_[i], prepared, record)) hits.push_back(record);
+            if (set_->intersect(primitives[i], prepared, record)) hits.push_back(record);
         }
         return false;
     });

@@ -417,7 +417,7 @@ std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
             node.bounds[2 * axis + 1][slot] = child.upper[axis];
         }
         if (child.is_leaf()) {
-            node.first[slot] = child.offset;
+            node.first[slot] = child.count == 1 ? binary.indices[child.offset] : child.offset;
             node.count[slot] = child.count;
         } else {
             node.count[slot] = Bvh4Node::kInterior;

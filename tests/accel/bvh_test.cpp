@@ -449,6 +449,8 @@ void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
     } else {
         const auto& nodes = bvh.wide_nodes();
         ASSERT_FALSE(nodes.empty());
+        // Through the leaves, each primitive must be reached exactly once.
+        std::vector<int> reached(set.size(), 0);
         for (std::size_t i = 0; i < nodes.size(); ++i) {
             const Bvh4Node& node = nodes[i];
             for (int slot = 0; slot < 4; ++slot) {
@@ -456,8 +458,18 @@ void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
                                         node.bounds[4][slot]};
                 const float upper[3] = {node.bounds[1][slot], node.bounds[3][slot],
                                         node.bounds[5][slot]};
+                if (node.count[slot] == 1) {
+                    // A one-primitive leaf names its primitive directly.
+                    ASSERT_LT(node.first[slot], set.size());
+                    EXPECT_TRUE(contains(lower, upper, set.bounds(node.first[slot]))) << i;
+                    ++reached[node.first[slot]];
+                    ++leaf_references;
+                    continue;
+                }
                 if (node.count[slot] != Bvh4Node::kInterior) {
                     EXPECT_TRUE(leaf_ok(lower, upper, node.first[slot], node.count[slot])) << i;
+                    for (std::uint32_t k = 0; k < node.count[slot]; ++k)
+                        ++reached[indices[node.first[slot] + k]];
                     leaf_references += node.count[slot];
                     continue;
                 }
@@ -473,6 +485,7 @@ void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
                 }
             }
         }
+        EXPECT_TRUE(std::all_of(reached.begin(), reached.end(), [](int r) { return r == 1; }));
     }
     EXPECT_EQ(leaf_references, set.size());
 }

@@ -61,7 +61,7 @@ public:
 
 private:
     /// Visits every leaf the ray may hit within [t_min, t_max], nearest entry first. `leaf`
-    /// is called as leaf(first, count, t_max) with the leaf's primitive index range and the
+    /// is called as leaf(primitives, count, t_max) with the leaf's primitive indices and the
     /// float upper bound of the interval, which it may lower; it returns true to stop.
     template <bool kCount, class LeafVisitor>
     void traverse(const Ray& ray, TraversalCounters& counters, LeafVisitor&& leaf) const;

@@ -44,7 +44,8 @@ static_assert(sizeof(BvhNode) == 32);
 
 /// A 4-wide node in two cache lines: the four children's boxes as structure of arrays
 /// (bounds[2 axis] = lower, bounds[2 axis + 1] = upper, one lane per child), and per child a
-/// reference: count == kInterior names the 4-wide node `first`; any other count is a leaf of
+/// reference: count == kInterior names the 4-wide node `first`; count == 1 is a leaf whose
+/// one primitive is `first` itself (saving a dependent load); any other count is a leaf of
 /// primitive index entries first .. first + count - 1. Unused slots are empty leaves with an
 /// empty box (lower = +inf, upper = -inf), which no slab test hits.
 struct alignas(64) Bvh4Node {
