@@ -133,8 +133,8 @@ bool hit_box(const BvhNode& node, const BoxRay& ray, float t_max, float& t_enter
 
 /// The four boxes of a 4-wide node at once, with the arithmetic of hit_box lane by lane.
 struct WideBoxRay {
-    /// Offsets (in floats, from Bvh4Node::bounds) of each axis' near and far planes.
-    std::size_t near_offset[3], far_offset[3];
+    /// Rows of WideBvhNode::bounds holding each axis' near and far planes.
+    std::size_t near_row[3], far_row[3];
 #if defined(__SSE2__)
     __m128 origin[3], inverse_near[3], inverse_far[3], t_min;
 
@@ -143,36 +143,41 @@ struct WideBoxRay {
             origin[axis] = _mm_set1_ps(ray.origin[axis]);
             inverse_near[axis] = _mm_set1_ps(ray.inverse_near[axis]);
             inverse_far[axis] = _mm_set1_ps(ray.inverse_far[axis]);
-            near_offset[axis] = 4 * (2 * axis + (ray.negative[axis] ? 1 : 0));
-            far_offset[axis] = 4 * (2 * axis + (ray.negative[axis] ? 0 : 1));
+            near_row[axis] = 2 * axis + (ray.negative[axis] ? 1 : 0);
+            far_row[axis] = 2 * axis + (ray.negative[axis] ? 0 : 1);
         }
         t_min = _mm_set1_ps(ray.t_min);
     }
 
     /// Bit i of the result says child i is entered, at t_enter[i].
-    template <bool kSigned>
-    int hit(const Bvh4Node& node, float t_max, float* t_enter) const {
-        const float* bounds = node.bounds[0];
-        __m128 t0 = t_min, t1 = _mm_set1_ps(t_max);
-        for (int axis = 0; axis < 3; ++axis) {
-            const __m128 t_near =
-                _mm_mul_ps(_mm_sub_ps(_mm_load_ps(bounds + near_offset[axis]), origin[axis]),
-                           inverse_near[axis]);
-            const __m128 t_far =
-                _mm_mul_ps(_mm_sub_ps(_mm_load_ps(bounds + far_offset[axis]), origin[axis]),
-                           inverse_far[axis]);
-            // maxps and minps return their second operand when either is NaN: NaN slabs are
-            // ignored, as in hit_box.
-            t0 = _mm_max_ps(t_near, t0);
-            t1 = _mm_min_ps(t_far, t1);
+    template <bool kSigned, int kWidth>
+    int hit(const WideBvhNode<kWidth>& node, float t_max, float* t_enter) const {
+        int mask = 0;
+        const __m128 t_max4 = _mm_set1_ps(t_max);
+        for (int group = 0; group < kWidth; group += 4) {
+            const float* bounds = node.bounds[0] + group;
+            __m128 t0 = t_min, t1 = t_max4;
+            for (int axis = 0; axis < 3; ++axis) {
+                const __m128 t_near = _mm_mul_ps(
+                    _mm_sub_ps(_mm_load_ps(bounds + kWidth * near_row[axis]), origin[axis]),
+                    inverse_near[axis]);
+                const __m128 t_far = _mm_mul_ps(
+                    _mm_sub_ps(_mm_load_ps(bounds + kWidth * far_row[axis]), origin[axis]),
+                    inverse_far[axis]);
+                // maxps and minps return their second operand when either is NaN: NaN slabs
+                // are ignored, as in hit_box.
+                t0 = _mm_max_ps(t_near, t0);
+                t1 = _mm_min_ps(t_far, t1);
+            }
+            if constexpr (kSigned) {
+                const __m128 sign = _mm_set1_ps(-0.0f), slack = _mm_set1_ps(kSlack);
+                t0 = _mm_sub_ps(t0, _mm_mul_ps(_mm_andnot_ps(sign, t0), slack));
+                t1 = _mm_add_ps(t1, _mm_mul_ps(_mm_andnot_ps(sign, t1), slack));
+            }
+            _mm_store_ps(t_enter + group, t0);
+            mask |= _mm_movemask_ps(_mm_cmple_ps(t0, t1)) << group;
         }
-        if constexpr (kSigned) {
-            const __m128 sign = _mm_set1_ps(-0.0f), slack = _mm_set1_ps(kSlack);
-            t0 = _mm_sub_ps(t0, _mm_mul_ps(_mm_andnot_ps(sign, t0), slack));
-            t1 = _mm_add_ps(t1, _mm_mul_ps(_mm_andnot_ps(sign, t1), slack));
-        }
-        _mm_store_ps(t_enter, t0);
-        return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
+        return mask;
     }
 #else
     float origin[3], inverse_near[3], inverse_far[3], t_min;
@@ -182,23 +187,22 @@ struct WideBoxRay {
             origin[axis] = ray.origin[axis];
             inverse_near[axis] = ray.inverse_near[axis];
             inverse_far[axis] = ray.inverse_far[axis];
-            near_offset[axis] = 4 * (2 * axis + (ray.negative[axis] ? 1 : 0));
-            far_offset[axis] = 4 * (2 * axis + (ray.negative[axis] ? 0 : 1));
+            near_row[axis] = 2 * axis + (ray.negative[axis] ? 1 : 0);
+            far_row[axis] = 2 * axis + (ray.negative[axis] ? 0 : 1);
         }
         t_min = ray.t_min;
     }
 
-    template <bool kSigned>
-    int hit(const Bvh4Node& node, float t_max, float* t_enter) const {
-        const float* bounds = node.bounds[0];
+    template <bool kSigned, int kWidth>
+    int hit(const WideBvhNode<kWidth>& node, float t_max, float* t_enter) const {
         int mask = 0;
-        for (int lane = 0; lane < 4; ++lane) {
+        for (int lane = 0; lane < kWidth; ++lane) {
             float t0 = t_min, t1 = t_max;
             for (int axis = 0; axis < 3; ++axis) {
                 const float t_near =
-                    (bounds[near_offset[axis] + lane] - origin[axis]) * inverse_near[axis];
+                    (node.bounds[near_row[axis]][lane] - origin[axis]) * inverse_near[axis];
                 const float t_far =
-                    (bounds[far_offset[axis] + lane] - origin[axis]) * inverse_far[axis];
+                    (node.bounds[far_row[axis]][lane] - origin[axis]) * inverse_far[axis];
                 t0 = t_near > t0 ? t_near : t0;
                 t1 = t_far < t1 ? t_far : t1;
             }
@@ -265,7 +269,8 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     require(config.max_leaf_size >= 1, "Bvh", "max_leaf_size", ">= 1", config.max_leaf_size);
     require_positive(config.traversal_cost, "Bvh", "traversal_cost");
     require_positive(config.intersection_cost, "Bvh", "intersection_cost");
-    require(config.width == 2 || config.width == 4, "Bvh", "width", "2 or 4", config.width);
+    require(config.width == 2 || config.width == 4 || config.width == 8, "Bvh", "width",
+            "2, 4 or 8", config.width);
     require(set.size() < std::size_t{Bvh4Node::kInterior}, "Bvh", "primitive count", "< 2^32 - 1",
             set.size());
     const auto start = std::chrono::steady_clock::now();
@@ -289,10 +294,13 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
 
     detail::BinaryBvh tree = detail::build_binary_bvh(primitives, config);
     primitives = {};
-    wide_nodes_.clear();
+    nodes_4_.clear();
+    nodes_8_.clear();
     binary_nodes_.clear();
     if (config.width == 4) {
-        wide_nodes_ = detail::collapse_to_4_wide(tree);
+        nodes_4_ = detail::collapse_to_wide<4>(tree);
+    } else if (config.width == 8) {
+        nodes_8_ = detail::collapse_to_wide<8>(tree);
     } else {
         binary_nodes_ = std::move(tree.nodes);
     }
@@ -301,9 +309,9 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     stats_ = AcceleratorStats{};
     stats_.name = "bvh";
     stats_.bytes = binary_nodes_.capacity() * sizeof(BvhNode) +
-                   wide_nodes_.capacity() * sizeof(Bvh4Node) +
+                   nodes_4_.capacity() * sizeof(Bvh4Node) + nodes_8_.capacity() * sizeof(Bvh8Node) +
                    indices_.capacity() * sizeof(std::uint32_t);
-    stats_.nodes = config.width == 4 ? wide_nodes_.size() : binary_nodes_.size();
+    stats_.nodes = nodes_4_.size() + nodes_8_.size() + binary_nodes_.size();
     stats_.primitives = stats_.references = set.size();
     char details[200];
     std::snprintf(details, sizeof details,
@@ -323,9 +331,15 @@ void Bvh<Set>::traverse(const Ray& ray, TraversalCounters& counters, LeafVisitor
     const BoxRay box_ray(ray);
     if (config_.width == 4) {
         if (box_ray.signed_interval) {
-            traverse_wide<kCount, true>(box_ray, ray.t_max, counters, leaf);
+            traverse_wide<kCount, true>(nodes_4_, box_ray, ray.t_max, counters, leaf);
         } else {
-            traverse_wide<kCount, false>(box_ray, ray.t_max, counters, leaf);
+            traverse_wide<kCount, false>(nodes_4_, box_ray, ray.t_max, counters, leaf);
+        }
+    } else if (config_.width == 8) {
+        if (box_ray.signed_interval) {
+            traverse_wide<kCount, true>(nodes_8_, box_ray, ray.t_max, counters, leaf);
+        } else {
+            traverse_wide<kCount, false>(nodes_8_, box_ray, ray.t_max, counters, leaf);
         }
     } else {
         if (box_ray.signed_interval) {
@@ -384,26 +398,28 @@ void Bvh<Set>::traverse_binary(const BoxRay& box_ray, double ray_t_max, Traversa
 }
 
 template <class Set>
-template <bool kCount, bool kSigned, class LeafVisitor>
-void Bvh<Set>::traverse_wide(const BoxRay& box_ray, double ray_t_max, TraversalCounters& counters,
+template <bool kCount, bool kSigned, int kWidth, class LeafVisitor>
+void Bvh<Set>::traverse_wide(const std::vector<WideBvhNode<kWidth>>& nodes, const BoxRay& box_ray,
+                             double ray_t_max, TraversalCounters& counters,
                              LeafVisitor&& leaf) const {
-    if (wide_nodes_.empty()) return;
+    using Node = WideBvhNode<kWidth>;
+    if (nodes.empty()) return;
     const WideBoxRay wide_ray(box_ray);
     float t_max = round_up(ray_t_max);
 
-    // Each level pushes at most three children.
-    WideEntry stack[3 * detail::kMaxDepth + 1];
+    // Each level pushes at most kWidth - 1 children.
+    WideEntry stack[(kWidth - 1) * detail::kMaxDepth + 1];
     WideEntry* top = stack;
-    std::uint32_t first = 0, count = Bvh4Node::kInterior;
-    alignas(16) float t_enter[4];
+    std::uint32_t first = 0, count = Node::kInterior;
+    alignas(16) float t_enter[kWidth];
     // Children that wait on the stack are fetched while the nearest one is traversed: a
     // node's two cache lines, a one-primitive leaf's primitive, a larger leaf's indices.
     auto prefetch = [&](std::uint32_t child_first, std::uint32_t child_count) {
 #if defined(__SSE2__)
-        if (child_count == Bvh4Node::kInterior) {
-            const char* address = reinterpret_cast<const char*>(&wide_nodes_[child_first]);
-            _mm_prefetch(address, _MM_HINT_T0);
-            _mm_prefetch(address + 64, _MM_HINT_T0);
+        if (child_count == Node::kInterior) {
+            const char* address = reinterpret_cast<const char*>(&nodes[child_first]);
+            for (std::size_t line = 0; line < sizeof(Node); line += 64)
+                _mm_prefetch(address + line, _MM_HINT_T0);
         } else if (child_count == 1) {
             prefetch_primitive(*set_, child_first);
         } else {
@@ -413,11 +429,11 @@ void Bvh<Set>::traverse_wide(const BoxRay& box_ray, double ray_t_max, TraversalC
     };
     for (;;) {
         // Descend through interior nodes, nearest child first, until a leaf or a dead end.
-        while (count == Bvh4Node::kInterior) {
-            const Bvh4Node& node = wide_nodes_[first];
+        while (count == Node::kInterior) {
+            const Node& node = nodes[first];
             if constexpr (kCount) {
                 ++counters.nodes_visited;
-                counters.boxes_tested += 4;
+                counters.boxes_tested += kWidth;
             }
             unsigned mask =
                 static_cast<unsigned>(wide_ray.template hit<kSigned>(node, t_max, t_enter));
@@ -448,7 +464,7 @@ void Bvh<Set>::traverse_wide(const BoxRay& box_ray, double ray_t_max, TraversalC
             first = top->first;
             count = top->count;
         }
-        if (count != Bvh4Node::kInterior) {
+        if (count != Node::kInterior) {
             if constexpr (kCount) ++counters.nodes_visited;
             // A one-primitive leaf holds the primitive's index itself.
             const std::uint32_t* primitives = count == 1 ? &first : &indices_[first];

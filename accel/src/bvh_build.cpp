@@ -368,12 +368,14 @@ double sah_cost(const BinaryBvh& tree, const BvhConfig& config) {
     return root_area > 0.0 ? total / root_area : 0.0;
 }
 
-/// Appends the 4-wide node that replaces binary node `index` and, depth first, its subtree;
+/// Appends the wide node that replaces binary node `index` and, depth first, its subtree;
 /// returns the new node's index.
+template <int kWidth>
 std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
-                            std::vector<Bvh4Node>& wide) {
+                            std::vector<WideBvhNode<kWidth>>& wide) {
+    using Node = WideBvhNode<kWidth>;
     const auto& nodes = binary.nodes;
-    std::array<std::uint32_t, 4> children{};
+    std::array<std::uint32_t, kWidth> children{};
     int child_count = 0;
     if (nodes[index].is_leaf()) {
         children[child_count++] = index;  // a lone leaf at the root
@@ -381,9 +383,9 @@ std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
         children[child_count++] = nodes[index].offset;
         children[child_count++] = nodes[index].offset + 1;
     }
-    // Open the interior child with the largest box until there are four: it is the one a
+    // Open the interior child with the largest box until there are kWidth: it is the one a
     // random ray is most likely to enter, so adopting its children saves the most visits.
-    while (child_count < 4) {
+    while (child_count < kWidth) {
         int widest = -1;
         double widest_area = -1.0;
         for (int i = 0; i < child_count; ++i) {
@@ -400,8 +402,8 @@ std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
 
     const auto wide_index = static_cast<std::uint32_t>(wide.size());
     wide.emplace_back();
-    for (int slot = 0; slot < 4; ++slot) {
-        Bvh4Node& node = wide[wide_index];
+    for (int slot = 0; slot < kWidth; ++slot) {
+        Node& node = wide[wide_index];
         if (slot >= child_count) {
             for (int axis = 0; axis < 3; ++axis) {
                 node.bounds[2 * axis][slot] = kInfinityFloat;
@@ -420,7 +422,7 @@ std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
             node.first[slot] = child.count == 1 ? binary.indices[child.offset] : child.offset;
             node.count[slot] = child.count;
         } else {
-            node.count[slot] = Bvh4Node::kInterior;
+            node.count[slot] = Node::kInterior;
             // The recursion may grow `wide`, so the node is looked up again afterwards.
             const std::uint32_t first = collapse_node(binary, children[slot], wide);
             wide[wide_index].first[slot] = first;
@@ -431,14 +433,18 @@ std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
 
 }  // namespace
 
-std::vector<Bvh4Node> collapse_to_4_wide(const BinaryBvh& binary) {
-    std::vector<Bvh4Node> wide;
+template <int kWidth>
+std::vector<WideBvhNode<kWidth>> collapse_to_wide(const BinaryBvh& binary) {
+    std::vector<WideBvhNode<kWidth>> wide;
     if (binary.nodes.empty()) return wide;
     wide.reserve(binary.nodes.size() / 2 + 1);
-    collapse_node(binary, 0, wide);
+    collapse_node<kWidth>(binary, 0, wide);
     wide.shrink_to_fit();
     return wide;
 }
+
+template std::vector<Bvh4Node> collapse_to_wide<4>(const BinaryBvh&);
+template std::vector<Bvh8Node> collapse_to_wide<8>(const BinaryBvh&);
 
 BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config) {
     BinaryBvh tree;

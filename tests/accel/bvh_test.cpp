@@ -197,17 +197,17 @@ TYPED_TEST(BvhMeshTest, SameHitsAsBruteForceOnEveryMeshAndLayout) {
         if (c.name == "teapot in stadium")
             box = Aabb(Point3(-0.2, -0.2, -0.2), Point3(0.2, 0.2, 0.2));
         const std::vector<Ray> rays = mixed_rays(box, c.rays, 100 + total_rays);
-        for (int width : {4, 2}) {
+        for (int width : {8, 4, 2}) {
             Bvh<TriangleSet<TypeParam>> bvh;
             bvh.build(set, BvhConfig{.width = width});
-            // The binary layout shares the traversal logic; a quarter of the rays suffice.
+            // The other layouts share the traversal logic; a quarter of the rays suffice.
             const std::vector<Ray> subset(rays.begin(),
-                                          rays.begin() + (width == 4 ? c.rays : c.rays / 4));
+                                          rays.begin() + (width == 8 ? c.rays : c.rays / 4));
             const int hits = expect_same_answers<TriangleSet<TypeParam>>(
                 bvh, brute, subset, c.name + " width " + std::to_string(width));
             // A meaningful share of the rays must hit, or the comparison proves little.
             EXPECT_GT(hits, static_cast<int>(subset.size()) / 5) << c.name;
-            if (width == 4) total_rays += static_cast<int>(subset.size());
+            if (width == 8) total_rays += static_cast<int>(subset.size());
         }
     }
     EXPECT_GE(total_rays, 100000);
@@ -227,7 +227,7 @@ TYPED_TEST(BvhMeshTest, AllHitsEqualBruteForceAsASet) {
             rays[i].t_min = -kInfinity;
             rays[i].t_max = kInfinity;
         }
-        for (int width : {4, 2}) {
+        for (int width : {8, 4, 2}) {
             Bvh<TriangleSet<TypeParam>> bvh;
             bvh.build(set, BvhConfig{.width = width});
             QueryScratch scratch;
@@ -287,7 +287,7 @@ TEST(Bvh, EmptySetAndSinglePrimitive) {
     const std::vector<Eigen::Vector3d> vertices = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
     const std::vector<std::array<std::uint32_t, 3>> triangles = {{0, 1, 2}};
     const TriangleSet<float> one(vertices, triangles);
-    for (int width : {2, 4}) {
+    for (int width : {2, 4, 8}) {
         Bvh<TriangleSet<float>> single;
         single.build(one, BvhConfig{.width = width});
         ASSERT_TRUE(single.intersect(ray, record, scratch));
@@ -310,7 +310,7 @@ TEST(Bvh, IdenticalTrianglesShareOneLeafAndTiesGoToTheLowestIndex) {
     const TriangleSet<float> set(vertices, triangles);
     BruteForce<TriangleSet<float>> brute;
     brute.build(set);
-    for (int width : {2, 4}) {
+    for (int width : {2, 4, 8}) {
         Bvh<TriangleSet<float>> bvh;
         bvh.build(set, BvhConfig{.width = width});
         QueryScratch scratch;
@@ -353,7 +353,7 @@ TEST(Bvh, FlatMeshWithParallelAndGrazingRays) {
         rays.push_back(Ray{Point3(p.x(), p.y(), -1), Vector3(0.0, -0.0, 2.0)});   // axis
         rays.push_back(Ray{Point3(std::round(p.x()), -1, 0), Vector3(0, 1, 0)});  // on edges
     }
-    for (int width : {2, 4}) {
+    for (int width : {2, 4, 8}) {
         Bvh<TriangleSet<float>> bvh;
         bvh.build(set, BvhConfig{.width = width});
         const int hits = expect_same_answers<TriangleSet<float>>(bvh, brute, rays, "flat");
@@ -447,45 +447,51 @@ void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
             }
         }
     } else {
-        const auto& nodes = bvh.wide_nodes();
-        ASSERT_FALSE(nodes.empty());
-        // Through the leaves, each primitive must be reached exactly once.
-        std::vector<int> reached(set.size(), 0);
-        for (std::size_t i = 0; i < nodes.size(); ++i) {
-            const Bvh4Node& node = nodes[i];
-            for (int slot = 0; slot < 4; ++slot) {
-                const float lower[3] = {node.bounds[0][slot], node.bounds[2][slot],
-                                        node.bounds[4][slot]};
-                const float upper[3] = {node.bounds[1][slot], node.bounds[3][slot],
-                                        node.bounds[5][slot]};
-                if (node.count[slot] == 1) {
-                    // A one-primitive leaf names its primitive directly.
-                    ASSERT_LT(node.first[slot], set.size());
-                    EXPECT_TRUE(contains(lower, upper, set.bounds(node.first[slot]))) << i;
-                    ++reached[node.first[slot]];
-                    ++leaf_references;
-                    continue;
-                }
-                if (node.count[slot] != Bvh4Node::kInterior) {
-                    EXPECT_TRUE(leaf_ok(lower, upper, node.first[slot], node.count[slot])) << i;
-                    for (std::uint32_t k = 0; k < node.count[slot]; ++k)
-                        ++reached[indices[node.first[slot] + k]];
-                    leaf_references += node.count[slot];
-                    continue;
-                }
-                ASSERT_GT(node.first[slot], i);  // children follow their parent
-                const Bvh4Node& child = nodes[node.first[slot]];
-                for (int s = 0; s < 4; ++s) {
-                    if (child.bounds[0][s] > child.bounds[1][s]) continue;  // unused slot
-                    EXPECT_TRUE(contains(
-                        lower, upper,
-                        Aabb(Point3(child.bounds[0][s], child.bounds[2][s], child.bounds[4][s]),
-                             Point3(child.bounds[1][s], child.bounds[3][s], child.bounds[5][s]))))
-                        << i << " slot " << slot;
+        auto check_wide = [&](const auto& nodes) {
+            constexpr int kChildren = std::decay_t<decltype(nodes[0])>::kChildren;
+            constexpr std::uint32_t kInterior = Bvh4Node::kInterior;
+            ASSERT_FALSE(nodes.empty());
+            // Through the leaves, each primitive must be reached exactly once.
+            std::vector<int> reached(set.size(), 0);
+            for (std::size_t i = 0; i < nodes.size(); ++i) {
+                const auto& node = nodes[i];
+                for (int slot = 0; slot < kChildren; ++slot) {
+                    const float lower[3] = {node.bounds[0][slot], node.bounds[2][slot],
+                                            node.bounds[4][slot]};
+                    const float upper[3] = {node.bounds[1][slot], node.bounds[3][slot],
+                                            node.bounds[5][slot]};
+                    if (node.count[slot] == 1) {
+                        // A one-primitive leaf names its primitive directly.
+                        ASSERT_LT(node.first[slot], set.size());
+                        EXPECT_TRUE(contains(lower, upper, set.bounds(node.first[slot]))) << i;
+                        ++reached[node.first[slot]];
+                        ++leaf_references;
+                        continue;
+                    }
+                    if (node.count[slot] != kInterior) {
+                        EXPECT_TRUE(leaf_ok(lower, upper, node.first[slot], node.count[slot])) << i;
+                        for (std::uint32_t k = 0; k < node.count[slot]; ++k)
+                            ++reached[indices[node.first[slot] + k]];
+                        leaf_references += node.count[slot];
+                        continue;
+                    }
+                    ASSERT_GT(node.first[slot], i);  // children follow their parent
+                    const auto& child = nodes[node.first[slot]];
+                    for (int s = 0; s < kChildren; ++s) {
+                        if (child.bounds[0][s] > child.bounds[1][s]) continue;  // unused slot
+                        EXPECT_TRUE(contains(
+                            lower, upper,
+                            Aabb(Point3(child.bounds[0][s], child.bounds[2][s], child.bounds[4][s]),
+                                 Point3(child.bounds[1][s], child.bounds[3][s],
+                                        child.bounds[5][s]))))
+                            << i << " slot " << slot;
+                    }
                 }
             }
-        }
-        EXPECT_TRUE(std::all_of(reached.begin(), reached.end(), [](int r) { return r == 1; }));
+            EXPECT_TRUE(std::all_of(reached.begin(), reached.end(), [](int r) { return r == 1; }));
+        };
+        if (width == 4) check_wide(bvh.nodes_4_wide());
+        if (width == 8) check_wide(bvh.nodes_8_wide());
     }
     EXPECT_EQ(leaf_references, set.size());
 }
@@ -493,7 +499,7 @@ void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
 TEST(Bvh, TreeInvariantsAndStats) {
     const TestMesh mesh = test::sphere_mesh(6);
     const TriangleSet<float> set(mesh.vertices, mesh.triangles);
-    for (int width : {2, 4}) {
+    for (int width : {2, 4, 8}) {
         Bvh<TriangleSet<float>> bvh;
         bvh.build(set, BvhConfig{.width = width});
         expect_valid_tree(bvh, set, width);
@@ -513,8 +519,8 @@ TEST(Bvh, TreeInvariantsAndStats) {
     const TriangleSet<double> stadium_set(stadium.vertices, stadium.triangles);
     for (int bins : {2, 7, 32}) {
         Bvh<TriangleSet<double>> bvh;
-        bvh.build(stadium_set, BvhConfig{.bins = bins, .max_leaf_size = 1, .width = 4});
-        expect_valid_tree(bvh, stadium_set, 4);
+        bvh.build(stadium_set, BvhConfig{.bins = bins, .max_leaf_size = 1, .width = 8});
+        expect_valid_tree(bvh, stadium_set, 8);
     }
 }
 
@@ -552,7 +558,7 @@ TEST(Bvh, PathologicalSpacingStaysWithinTheDepthBound) {
     const TriangleSet<double> set(mesh.vertices, mesh.triangles);
     BruteForce<TriangleSet<double>> brute;
     brute.build(set);
-    for (int width : {2, 4}) {
+    for (int width : {2, 4, 8}) {
         Bvh<TriangleSet<double>> bvh;
         bvh.build(set, BvhConfig{.bins = 2, .max_leaf_size = 1, .width = width});
         const std::string details = bvh.stats().details;

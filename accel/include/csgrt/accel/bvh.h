@@ -51,12 +51,14 @@ public:
                   QueryScratch& scratch) const override;
     AcceleratorStats stats() const override { return stats_; }
 
-    /// The binary nodes (width 2; empty for width 4), the 4-wide nodes (width 4) and the
-    /// primitive indices in leaf order: for tests of the tree's invariants.
+    /// The binary nodes (width 2), the 4- or 8-wide nodes (width 4 or 8; each empty for the
+    /// other widths) and the primitive indices in leaf order: for tests of the tree's
+    /// invariants.
     const std::vector<BvhNode, AlignedAllocator<BvhNode>>& binary_nodes() const {
         return binary_nodes_;
     }
-    const std::vector<Bvh4Node>& wide_nodes() const { return wide_nodes_; }
+    const std::vector<Bvh4Node>& nodes_4_wide() const { return nodes_4_; }
+    const std::vector<Bvh8Node>& nodes_8_wide() const { return nodes_8_; }
     const std::vector<std::uint32_t>& primitive_indices() const { return indices_; }
 
 private:
@@ -70,9 +72,9 @@ private:
     template <bool kCount, bool kSigned, class LeafVisitor>
     void traverse_binary(const detail::BoxRay& box_ray, double t_max, TraversalCounters& counters,
                          LeafVisitor&& leaf) const;
-    template <bool kCount, bool kSigned, class LeafVisitor>
-    void traverse_wide(const detail::BoxRay& box_ray, double t_max, TraversalCounters& counters,
-                       LeafVisitor&& leaf) const;
+    template <bool kCount, bool kSigned, int kWidth, class LeafVisitor>
+    void traverse_wide(const std::vector<WideBvhNode<kWidth>>& nodes, const detail::BoxRay& box_ray,
+                       double t_max, TraversalCounters& counters, LeafVisitor&& leaf) const;
 
     template <bool kCount>
     bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
@@ -83,7 +85,8 @@ private:
     const Set* set_ = nullptr;
     BvhConfig config_;
     std::vector<BvhNode, AlignedAllocator<BvhNode>> binary_nodes_;
-    std::vector<Bvh4Node> wide_nodes_;
+    std::vector<Bvh4Node> nodes_4_;
+    std::vector<Bvh8Node> nodes_8_;
     std::vector<std::uint32_t> indices_;
     AcceleratorStats stats_;
 };
