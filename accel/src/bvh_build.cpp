@@ -169,7 +169,22 @@ public:
 
         Range left, right;
         bool split = false;
-        if (count > 1 && depth < kMaxSahDepth) {
+        if (count == 2 && depth < kMaxSahDepth && !coincident(range.centroids)) {
+            // Two primitives allow one split, whose SAH cost needs no bins: this is the most
+            // common node near the leaves.
+            const BuildPrimitive* pair = primitives_.data() + range.begin;
+            const Box a = Box::of(pair[0]), b = Box::of(pair[1]);
+            const double split_cost = config_.traversal_cost + config_.intersection_cost *
+                                                                   (a.half_area() + b.half_area()) /
+                                                                   range.box.half_area();
+            if (split_cost < 2.0 * config_.intersection_cost || config_.max_leaf_size < 2) {
+                left = {range.begin, range.begin + 1, a, Box::empty()};
+                right = {range.begin + 1, range.end, b, Box::empty()};
+                left.centroids.extend(doubled_centroid(pair[0]));
+                right.centroids.extend(doubled_centroid(pair[1]));
+                split = true;
+            }
+        } else if (count > 1 && depth < kMaxSahDepth) {
             const int bin_count = bins_for(count);
             const BinMapping mapping(range.centroids, bin_count);
             const Split best = find_split(range, mapping, bin_count);
@@ -211,6 +226,14 @@ public:
     std::size_t leaf_count() const { return leaves_.load(); }
 
 private:
+    /// Whether all centroids are one point (no split by centroid can separate them).
+    static bool coincident(const Box& centroids) {
+        float l[4], h[4];
+        centroids.lower.store(l);
+        centroids.upper.store(h);
+        return !(l[0] < h[0] || l[1] < h[1] || l[2] < h[2]);
+    }
+
     /// Small nodes get fewer bins: the sweep over the bins would otherwise cost more than
     /// binning their few primitives, and with a handful of centroids more bins add nothing.
     int bins_for(std::uint32_t count) const {

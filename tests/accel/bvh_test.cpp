@@ -578,10 +578,10 @@ TEST(Bvh, PathologicalSpacingStaysWithinTheDepthBound) {
 }
 
 TEST(Bvh, CountedQueriesDoFarLessWorkThanBruteForce) {
-    // sphere_mesh(6): 32768 triangles. Brute force tests all of them per ray; the BVH visits a
-    // few dozen nodes and tests a handful of triangles (measured: about 20 nodes and 4
-    // triangles per camera-like ray), so (nodes + triangles) per ray must stay under 0.5% of
-    // brute force's triangle tests.
+    // sphere_mesh(6): 32768 triangles. Brute force tests all of them per ray; the 8-wide BVH
+    // visits about 8 nodes (leaves included) and tests about 2.6 triangles per ray here
+    // (measured), so nodes + triangles per ray must stay under 1/1000 of brute force's
+    // triangle tests (about 10 against 33: a factor 3 of headroom).
     const TestMesh mesh = test::sphere_mesh(6);
     const TriangleSet<float> set(mesh.vertices, mesh.triangles);
     Bvh<TriangleSet<float>> bvh;
@@ -602,7 +602,7 @@ TEST(Bvh, CountedQueriesDoFarLessWorkThanBruteForce) {
     EXPECT_EQ(naive.primitives_tested, std::uint64_t(rays) * set.size());
     EXPECT_GE(tree.nodes_visited, std::uint64_t(rays));  // at least the root, every ray
     EXPECT_EQ(tree.boxes_tested % 4, 0u);                // four boxes per 4-wide node
-    EXPECT_LT((tree.nodes_visited + tree.primitives_tested) * 200, naive.primitives_tested);
+    EXPECT_LT((tree.nodes_visited + tree.primitives_tested) * 1000, naive.primitives_tested);
 }
 
 TEST(Bvh, ConcurrentQueriesGiveTheSameAnswers) {
