@@ -250,7 +250,7 @@ void prefetch_primitive([[maybe_unused]] const Set& set, [[maybe_unused]] std::u
 #endif
 }
 
-/// Stack entries: a node (binary) or a child reference (4-wide), and its entry distance.
+/// Stack entries: a node (binary) or a child reference (wide), and its entry distance.
 struct BinaryEntry {
     std::uint32_t node;
     float t_enter;
@@ -271,8 +271,8 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     require_positive(config.intersection_cost, "Bvh", "intersection_cost");
     require(config.width == 2 || config.width == 4 || config.width == 8, "Bvh", "width",
             "2, 4 or 8", config.width);
-    require(set.size() < std::size_t{Bvh4Node::kInterior}, "Bvh", "primitive count", "< 2^32 - 1",
-            set.size());
+    // Node indices (up to twice the primitive count) and leaf counts are 32-bit.
+    require(set.size() < (std::size_t{1} << 31), "Bvh", "primitive count", "< 2^31", set.size());
     const auto start = std::chrono::steady_clock::now();
     set_ = &set;
     config_ = config;

@@ -13,8 +13,9 @@ struct BoxRay;
 }
 
 /// A bounding volume hierarchy over a primitive set, built top down with the binned SAH
-/// (Wald 2007, see bvh_build.h) and, by default, collapsed into 4-wide nodes whose four boxes
-/// are tested at once. Each primitive is referenced exactly once, by index, in leaf order.
+/// (Wald 2007, see bvh_build.h) and, by default, collapsed into 8-wide nodes whose boxes are
+/// tested four at a time with SSE. Each primitive is referenced exactly once, by index, in
+/// leaf order (a leaf of one primitive names it directly).
 ///
 /// Boxes are float, rounded outward from the set's double boxes after padding them by
 /// kPrimitivePadding of their size and magnitude, and the float slab test widens each
@@ -23,9 +24,9 @@ struct BoxRay;
 /// box test (a few float ulps of t), the float ray origin, and the float triangle test, whose
 /// hits lie a few float ulps of the triangle's size and coordinates off the exact triangle
 /// (Woop et al. 2013): a primitive the set reports as hit is never culled, so every query
-/// returns exactly what BruteForce returns. Rays the float test cannot represent (a
-/// coordinate or a reciprocal direction component beyond 2^100) fall back to visiting every
-/// node, which is slow but exact.
+/// returns exactly what BruteForce returns. Rays the float test cannot represent (an origin
+/// coordinate beyond 2^100, a non-zero direction component outside [2^-100, 2^100]) fall back
+/// to visiting every node, which is slow but exact. docs/structures.md has the argument.
 ///
 /// Traversal is near child first (by entry distance), with a fixed stack on the C++ stack;
 /// subtrees whose entry lies beyond the nearest hit so far are skipped.

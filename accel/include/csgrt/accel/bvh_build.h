@@ -110,7 +110,7 @@ struct BinaryBvh {
 
 /// Builds a binary BVH over `primitives` (reordered in place) with the binned surface-area
 /// heuristic of Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies", 2007.
-/// Below a depth of kMaxSahDepth nodes are split at the object median instead, so the depth
+/// Beyond a depth of kMaxSahDepth nodes are split at the object median instead, so the depth
 /// stays under kMaxDepth whatever the input. The config is assumed valid.
 BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config);
 
