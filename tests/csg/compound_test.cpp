@@ -8,6 +8,7 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
+#include "csgrt/core/plane.h"
 #include "csgrt/core/sphere.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/scene.h"
@@ -30,33 +31,10 @@ CompoundConfig structure(const char* name) {
     return config;
 }
 
-// Test fixture: the unbounded ground y = 0 (an open surface, like the library's plane).
-class Ground final : public Shape {
-public:
-    std::string_view kind() const override { return "ground"; }
-    Aabb bounds() const override { return Aabb::infinite(); }
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const override {
-        if (ray.direction.y() == 0.0) return false;
-        const double t = -ray.origin.y() / ray.direction.y();
-        if (!ray.in_range(t)) return false;
-        record = HitRecord{.t = t, .shape = this, .primitive = 0};
-        return true;
-    }
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override {
-        HitRecord record;
-        return nearest_hit(ray, record, scratch);
-    }
-    Hit finish(const Ray& ray, const HitRecord& record) const override {
-        Hit hit;
-        hit.t = record.t;
-        hit.point = ray.at(record.t);
-        hit.geometric_normal = hit.shading_normal = Normal3(0, 1, 0);
-        hit.shape = this;
-        hit.primitive_id = 0;
-        hit.front_face = ray.direction.y() < 0.0;
-        return hit;
-    }
-};
+// The unbounded ground y = 0, an open surface.
+std::shared_ptr<const Shape> ground_plane() {
+    return std::make_shared<Plane>(Point3(0, 0, 0), Normal3(0, 1, 0));
+}
 
 // Test fixture: forwards to a shape and counts the nearest_hit and any_hit calls it receives.
 class Counted final : public Shape {
@@ -169,7 +147,7 @@ TEST(Compound, IntervalIsHonouredAtBothEnds) {
 }
 
 TEST(Compound, UnboundedChildrenAreAskedOnEveryRayAndTieByIndex) {
-    auto ground = std::make_shared<Ground>();
+    auto ground = ground_plane();
     const Compound compound({sphere(0, 1, 0, 1), ground, sphere(5, 3, 0, 1)});
     EXPECT_FALSE(compound.bounds().is_finite());
     // Straight down onto the sphere that rests on the ground: the sphere first.
@@ -200,17 +178,16 @@ TEST(Compound, UnboundedChildrenAreAskedOnEveryRayAndTieByIndex) {
 
 TEST(Compound, SolidOnlyWhenEveryChildIsASolid) {
     EXPECT_TRUE(Compound({sphere(0, 0, 0, 1), sphere(3, 0, 0, 1)}).is_solid());
-    EXPECT_FALSE(Compound({sphere(0, 0, 0, 1), std::make_shared<Ground>()}).is_solid());
+    EXPECT_FALSE(Compound({sphere(0, 0, 0, 1), ground_plane()}).is_solid());
     EXPECT_FALSE(Compound(Shapes{}).is_solid());
     const Compound empty{Shapes{}};
     EXPECT_FALSE(empty.intersect(Ray{Point3(0, 0, 0), Vector3(1, 0, 0)}));
     EXPECT_TRUE(empty.bounds().is_empty());
     EXPECT_EQ(empty.accelerator_name(), "");
     // A non-solid compound is no CSG operand.
-    EXPECT_THROW(
-        Boolean(BooleanOperation::Union, sphere(0, 0, 0, 1),
-                std::make_shared<Compound>(Shapes{sphere(0, 0, 0, 1), std::make_shared<Ground>()})),
-        InvalidParameter);
+    EXPECT_THROW(Boolean(BooleanOperation::Union, sphere(0, 0, 0, 1),
+                         std::make_shared<Compound>(Shapes{sphere(0, 0, 0, 1), ground_plane()})),
+                 InvalidParameter);
 }
 
 TEST(Compound, BadArgumentsThrow) {
@@ -222,7 +199,7 @@ TEST(Compound, BadArgumentsThrow) {
 }
 
 TEST(Compound, InvalidRaysHitNothing) {
-    const Compound compound({sphere(0, 0, 0, 1), std::make_shared<Ground>()});
+    const Compound compound({sphere(0, 0, 0, 1), ground_plane()});
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (const Ray& ray :
          {Ray{Point3(nan, 0, 0), Vector3(0, 0, 1)}, Ray{Point3(0, 0, -5), Vector3(0, kInfinity, 1)},
@@ -334,7 +311,7 @@ TEST(Compound, StructuresAndHierarchiesGiveTheSameHitsAsBruteForce) {
         spheres.push_back(sphere(random.uniform(-50, 50), random.uniform(-50, 50),
                                  random.uniform(-50, 50), random.uniform(0.2, 3.0)));
     }
-    spheres.push_back(std::make_shared<Ground>());
+    spheres.push_back(ground_plane());
     const Compound brute(spheres, structure("brute"));
     const Compound automatic(spheres);
     const auto hierarchy = make_hierarchy(spheres, 4);

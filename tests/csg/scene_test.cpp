@@ -11,6 +11,7 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
+#include "csgrt/core/plane.h"
 #include "csgrt/core/sphere.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/compound.h"
@@ -25,33 +26,10 @@ SceneConfig structure(const char* name) {
     return config;
 }
 
-// Test fixture: the unbounded ground y = 0 (an open surface, like the library's plane).
-class Ground final : public Shape {
-public:
-    std::string_view kind() const override { return "ground"; }
-    Aabb bounds() const override { return Aabb::infinite(); }
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const override {
-        if (ray.direction.y() == 0.0) return false;
-        const double t = -ray.origin.y() / ray.direction.y();
-        if (!ray.in_range(t)) return false;
-        record = HitRecord{.t = t, .shape = this, .primitive = 0};
-        return true;
-    }
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override {
-        HitRecord record;
-        return nearest_hit(ray, record, scratch);
-    }
-    Hit finish(const Ray& ray, const HitRecord& record) const override {
-        Hit hit;
-        hit.t = record.t;
-        hit.point = ray.at(record.t);
-        hit.geometric_normal = hit.shading_normal = Normal3(0, 1, 0);
-        hit.shape = this;
-        hit.primitive_id = 0;
-        hit.front_face = ray.direction.y() < 0.0;
-        return hit;
-    }
-};
+// The unbounded ground y = 0, an open surface.
+std::shared_ptr<const Shape> ground_plane() {
+    return std::make_shared<Plane>(Point3(0, 0, 0), Normal3(0, 1, 0));
+}
 
 // The example of docs/scene.md, verbatim between the markers: a 20-object scene in C++.
 Scene docs_example() {
@@ -131,7 +109,7 @@ TEST(Scene, ObjectIdsNameTheObjectAndTiesGoToTheLowerIndex) {
     Scene scene;
     auto a = std::make_shared<Sphere>(Point3(0, 1, 0), 1.0);
     scene.add_object(std::make_shared<Sphere>(Point3(5, 1, 0), 1.0));  // 0
-    scene.add_object(std::make_shared<Ground>());                      // 1
+    scene.add_object(ground_plane());                                  // 1
     scene.add_object(a);                                               // 2
     scene.add_object(a);                                               // 3: the same sphere
     scene.commit();
@@ -192,7 +170,7 @@ TEST(Scene, LifecycleAndValidation) {
 TEST(Scene, InvalidRaysHitNothing) {
     Scene scene;
     scene.add_object(std::make_shared<Sphere>(Point3(0, 0, 0), 1.0));
-    scene.add_object(std::make_shared<Ground>());
+    scene.add_object(ground_plane());
     scene.commit();
     QueryScratch scratch;
     const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -233,7 +211,7 @@ RandomScene random_scene(std::uint64_t seed) {
                     std::make_shared<Compound>(std::vector<std::shared_ptr<const Shape>>{
                         ball, std::make_shared<Sphere>(c + Vector3(0, 2 * r, 0), 0.5 * r)}));
         }
-        if (i == 150) shapes.push_back(std::make_shared<Ground>());
+        if (i == 150) shapes.push_back(ground_plane());
     }
     RandomScene result;
     for (const auto& shape : shapes) {
