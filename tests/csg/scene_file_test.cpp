@@ -12,6 +12,7 @@
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/compound.h"
+#include "support/random.h"
 
 namespace csgrt {
 namespace {
@@ -332,6 +333,51 @@ TEST(SceneFile, CompleteExamplesInTheDocsLoad) {
         }
     }
     EXPECT_GE(loaded, 1);
+}
+
+// Seeded random edits of the shipped scenes (characters replaced by JSON punctuation, digits
+// and letters, deleted, or duplicated): every result either loads or throws SceneError,
+// never anything else and never a crash.
+TEST(SceneFile, MutatedScenesLoadOrGiveASceneError) {
+    test::Random random(404);
+    const std::string alphabet = "{}[],:\"-+.0123456789eEtrufalsn xyz_/";
+    int loaded = 0, rejected = 0;
+    for (const char* name : {"showcase.json", "part_objects.json"}) {
+        std::ifstream file(kScenes / name);
+        std::ostringstream buffer;
+        buffer << file.rdbuf();
+        const std::string original = buffer.str();
+        ASSERT_GT(original.size(), 1000u);
+        for (int i = 0; i < 600; ++i) {
+            std::string text = original;
+            const int edits = random.integer(1, 3);
+            for (int e = 0; e < edits; ++e) {
+                const auto at =
+                    static_cast<std::size_t>(random.integer(0, static_cast<int>(text.size()) - 1));
+                switch (random.integer(0, 2)) {
+                    case 0:
+                        text[at] = alphabet[random.integer(0, int(alphabet.size()) - 1)];
+                        break;
+                    case 1:
+                        text.erase(at, 1);
+                        break;
+                    default:
+                        text.insert(at, text.substr(at, random.integer(1, 12)));
+                }
+            }
+            try {
+                load_scene_from_string(text, name, kScenes).commit();
+                ++loaded;
+            } catch (const SceneError& error) {
+                EXPECT_EQ(std::string(error.what()).rfind(std::string(name) + ": ", 0), 0u)
+                    << error.what();
+                ++rejected;
+            }
+        }
+    }
+    // Most edits break something; some (inside a description or a number) still load.
+    EXPECT_GT(rejected, 600);
+    EXPECT_GT(loaded, 20);
 }
 
 TEST(SceneFile, MessagesForStringsNameTheGivenName) {
