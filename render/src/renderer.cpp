@@ -2,12 +2,14 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <optional>
 #include <string>
 #include <variant>
 
@@ -195,6 +197,12 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
             if (settings.progress) settings.progress(double(done) / tile_count);
         }
     };
+    // An explicit thread count may exceed the cores: the global control lets oneTBB start that
+    // many workers (the arena alone would be capped at the core count, with a warning).
+    std::optional<tbb::global_control> parallelism;
+    if (settings.threads > 0) {
+        parallelism.emplace(tbb::global_control::max_allowed_parallelism, settings.threads);
+    }
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     arena.execute(
         [&] { tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), render_tiles); });

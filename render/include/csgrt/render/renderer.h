@@ -16,7 +16,8 @@ struct RenderSettings {
     /// Colour samples per pixel, on a stratified jittered grid (sampling.h). One sample is
     /// taken at the pixel centre, unjittered.
     int samples_per_pixel = 1;
-    /// Worker threads; 0 lets oneTBB use every core. The image does not depend on it.
+    /// Worker threads; 0 lets oneTBB use every core. A positive count also caps oneTBB's
+    /// process-wide parallelism while the render runs. The image does not depend on it.
     int threads = 0;
     /// Pixels per side of the square tiles handed to the threads.
     int tile_size = 16;
