@@ -43,6 +43,7 @@ set(CSGRT_KNOWN_DEPENDENCIES
     "TBB::|TBB"
     "OpenEXR::|OpenEXR 3"
     "PNG::|PNG"
+    "CLI11::|CLI11"
     "nlohmann_json::|nlohmann_json"
     "OpenMesh|OpenMesh"
     "embree|embree 3")
