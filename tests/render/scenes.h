@@ -48,8 +48,8 @@ inline Scene csg_solids() {
     Camera camera;
     camera.projection = Camera::Projection::Orthographic;
     camera.position = Point3(2.5, 2.0, 5.0);
-    camera.look_at = Point3(0.6, 0.0, 0.0);
-    camera.orthographic_height = 4.0;
+    camera.look_at = Point3(0.9, 0.1, 0.0);
+    camera.orthographic_height = 4.8;
     scene.set_camera(camera);
     return scene;
 }
