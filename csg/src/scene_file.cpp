@@ -174,8 +174,10 @@ public:
         for (auto it = value_.begin(); it != value_.end(); ++it) {
             if (std::find(asked_.begin(), asked_.end(), it.key()) != asked_.end()) continue;
             std::string message = "unknown key \"" + it.key() + "\" in " + what_;
-            if (it.key() == "material" || it.key() == "name" || it.key() == "materials") {
+            if (it.key() == "material" || it.key() == "name") {
                 message += " (\"" + it.key() + "\" belongs to the top-level objects)";
+            } else if (it.key() == "materials") {
+                message += " (\"materials\" belongs to top-level grids)";
             }
             std::string known;
             for (const std::string& key : asked_) known += (known.empty() ? "" : ", ") + key;
@@ -500,8 +502,15 @@ std::string known_types() {
     const auto colon = message.find(": ");
     const auto must = message.find(" must be ");
     if (colon != std::string::npos && must != std::string::npos && must > colon) {
-        const std::string parameter = message.substr(colon + 2, must - colon - 2);
-        if (node.is_object() && node.contains(parameter)) pointer = fields.pointer(parameter);
+        std::string parameter = message.substr(colon + 2, must - colon - 2);
+        // The structure name of a compound or grid is its "accelerator" key; the keys every
+        // node may have are never a shape's parameter.
+        if (message.starts_with("make_accelerator: name")) parameter = "accelerator";
+        const bool shape_key = parameter != "name" && parameter != "material" &&
+                               parameter != "type" && parameter != "transform";
+        if (shape_key && node.is_object() && node.contains(parameter)) {
+            pointer = fields.pointer(parameter);
+        }
         if (angles && (parameter.starts_with("phi") || parameter.starts_with("theta"))) {
             message += " (radians: the file's degrees times pi / 180)";
         }

@@ -300,6 +300,31 @@ TEST(SceneFile, CameraLightsAndMaterials) {
     EXPECT_TRUE(bare.objects().empty());
 }
 
+// Every complete scene shown in docs/scene-format.md (a ```json block that is a whole object)
+// loads and commits.
+TEST(SceneFile, CompleteExamplesInTheDocsLoad) {
+    std::ifstream file(fs::path(CSGRT_SOURCE_DIR) / "docs" / "scene-format.md");
+    std::string line, block;
+    bool in_block = false;
+    int loaded = 0;
+    while (std::getline(file, line)) {
+        if (line == "```json") {
+            in_block = true;
+            block.clear();
+        } else if (in_block && line == "```") {
+            in_block = false;
+            if (block.rfind("{\n", 0) != 0 || block.find("\n}\n") != block.size() - 3) continue;
+            Scene scene = load(block);
+            scene.commit();
+            EXPECT_GT(scene.objects().size(), 0u);
+            ++loaded;
+        } else if (in_block) {
+            block += line + "\n";
+        }
+    }
+    EXPECT_GE(loaded, 1);
+}
+
 TEST(SceneFile, MessagesForStringsNameTheGivenName) {
     const std::string message = error_of(R"({"objects": [{"type": "sphere"}]})");
     EXPECT_EQ(message.rfind("test.json: /objects/0: missing required key", 0), 0u) << message;

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "csgrt/core/error.h"
@@ -98,6 +101,30 @@ TEST(Scene, DocsExampleBuildsAndHitsTheNearestBall) {
     EXPECT_NEAR(hit->t, 13.0, 1e-12);
     EXPECT_TRUE(scene.bounds().contains(Point3(6, 1, 0)));
     EXPECT_NEAR(scene.bounds().upper.y(), 2.0, 1e-12);
+}
+
+std::string read_file(const std::filesystem::path& path) {
+    std::ifstream file(path);
+    std::ostringstream text;
+    text << file.rdbuf();
+    return text.str();
+}
+
+TEST(Scene, DocsShowTheExampleVerbatim) {
+    const std::filesystem::path root(CSGRT_SOURCE_DIR);
+    const std::string source = read_file(root / "tests" / "csg" / "scene_test.cpp");
+    const std::string begin_marker = "// docs-example-begin\n";
+    const auto begin = source.find(begin_marker) + begin_marker.size();
+    const auto end = source.rfind("\n", source.find("    // docs-example-end")) + 1;
+    // The example without its four spaces of indentation.
+    std::istringstream lines(source.substr(begin, end - begin));
+    std::string example, line;
+    while (std::getline(lines, line)) example += (line.size() >= 4 ? line.substr(4) : line) + "\n";
+    ASSERT_GT(example.size(), 500u);
+    EXPECT_NE(read_file(root / "docs" / "scene.md").find("```cpp\n" + example + "```"),
+              std::string::npos)
+        << "docs/scene.md does not show the example of scene_test.cpp:\n"
+        << example;
 }
 
 TEST(Scene, ObjectIdsNameTheObjectAndTiesGoToTheLowerIndex) {
