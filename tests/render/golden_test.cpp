@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "csgrt/csg/scene.h"
+#include "csgrt/csg/scene_file.h"
 #include "csgrt/render/exr.h"
 #include "csgrt/render/renderer.h"
 #include "render/scenes.h"
@@ -22,6 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const fs::path kGoldenDirectory = fs::path(CSGRT_SOURCE_DIR) / "tests" / "golden";
+const fs::path kScenes = fs::path(CSGRT_SOURCE_DIR) / "data" / "scenes";
 
 bool updating_golden() {
     const char* value = std::getenv("CSGRT_UPDATE_GOLDEN");
@@ -63,6 +65,9 @@ std::vector<GoldenCase> golden_cases() {
         {"spheres_on_a_plane", test::spheres_on_a_plane, 4},
         {"csg_solids", test::csg_solids, 4},
         {"sphere_lattice_eye_light", [] { return test::sphere_lattice(4); }, 1},
+        // The shipped scene files, through the loader (data/scenes, docs/scene-format.md).
+        {"scene_showcase", [] { return load_scene(kScenes / "showcase.json"); }, 4},
+        {"scene_part_objects", [] { return load_scene(kScenes / "part_objects.json"); }, 4},
     };
 }
 
