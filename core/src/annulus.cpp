@@ -62,7 +62,7 @@ Hit Annulus::finish(const Ray& ray, const HitRecord& record) const {
     const double r = std::hypot(local.x(), local.z());
     const double radial = (r - inner_radius_) / (outer_radius_ - inner_radius_);
     hit.uv = Vector2(std::clamp(radial, 0.0, 1.0),
-                     azimuth_.fraction(AzimuthRange::azimuth(local.x(), local.z())));
+                     azimuth_.fraction(AngleRange::azimuth(local.x(), local.z())));
     hit.shape = this;
     hit.primitive_id = record.primitive;
     hit.front_face = ray.direction.dot(frame_.normal) < 0.0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "csgrt/core/angle_range.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/polynomial.h"
 
@@ -224,7 +225,7 @@ Hit Cone::finish(const Ray& ray, const HitRecord& record) const {
             const bool top = record.primitive == kTopCap;
             p.y() = top ? height_ : 0.0;
             hit.geometric_normal = Normal3(0.0, top ? 1.0 : -1.0, 0.0);
-            hit.uv = Vector2(detail::azimuth(p.x(), p.z()) / kTwoPi,
+            hit.uv = Vector2(AngleRange::azimuth(p.x(), p.z()) / kTwoPi,
                              std::min(distance / (top ? top_radius_ : base_radius_), 1.0));
             break;
         }
@@ -236,7 +237,7 @@ Hit Cone::finish(const Ray& ray, const HitRecord& record) const {
                 // Move the point along the normal onto the side: (|xz| - rho(y)) cos(half angle)
                 // is its signed distance to the infinite cone there.
                 p -= (distance - radius_at(p.y())) * normal_radial_ * hit.geometric_normal;
-                hit.uv = Vector2(detail::azimuth(p.x(), p.z()) / kTwoPi,
+                hit.uv = Vector2(AngleRange::azimuth(p.x(), p.z()) / kTwoPi,
                                  std::clamp(p.y() / height_, 0.0, 1.0));
                 break;
             }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "csgrt/core/angle_range.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/polynomial.h"
 
@@ -110,13 +111,6 @@ bool nearest_open_surface_hit(const Ray& ray, const LineInterval& side, const Li
     return false;
 }
 
-double azimuth(double x, double z) {
-    double phi = std::atan2(x, z);
-    if (phi < 0.0) phi += kTwoPi;
-    // A tiny negative angle rounds up to exactly 2 pi, which belongs to 0.
-    return phi < kTwoPi ? phi : 0.0;
-}
-
 }  // namespace detail
 
 Cylinder::Cylinder(double radius, double y_min, double y_max, bool capped)
@@ -193,7 +187,7 @@ Hit Cylinder::finish(const Ray& ray, const HitRecord& record) const {
     Hit hit;
     hit.t = record.t;
     Point3 p = ray.at(record.t);
-    const double phi = detail::azimuth(p.x(), p.z());
+    const double phi = AngleRange::azimuth(p.x(), p.z());
     const double distance = std::hypot(p.x(), p.z());
     if (record.primitive == kSide) {
         // Project radially onto the side, which removes the rounding of o + t d along the

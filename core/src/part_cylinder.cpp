@@ -10,36 +10,21 @@ namespace csgrt {
 
 PartCylinder::PartCylinder(double radius, double y_min, double y_max, double phi_min,
                            double phi_max)
-    : radius_(radius), y_min_(y_min), y_max_(y_max), phi_min_(phi_min), phi_max_(phi_max) {
+    : radius_(radius), y_min_(y_min), y_max_(y_max), azimuth_(phi_min, phi_max, "PartCylinder") {
     require_positive(radius, "PartCylinder", "radius");
     require_finite(y_min, "PartCylinder", "y_min");
     require_finite(y_max, "PartCylinder", "y_max");
     require(y_min < y_max, "PartCylinder", "y_max", "> y_min", y_max);
-    require(phi_min >= 0.0 && phi_min < kTwoPi, "PartCylinder", "phi_min", "in [0, 2 pi)", phi_min);
-    require(phi_max > phi_min && phi_max <= phi_min + kTwoPi, "PartCylinder", "phi_max",
-            "in (phi_min, phi_min + 2 pi]", phi_max);
 
-    // The arc's box: its two ends and every axis extreme (a multiple of pi / 2) between them.
-    Aabb arc;
-    auto add = [&](double phi) {
-        arc.extend(Point3(radius_ * std::sin(phi), y_min_, radius_ * std::cos(phi)));
-        arc.extend(Point3(radius_ * std::sin(phi), y_max_, radius_ * std::cos(phi)));
-    };
-    add(phi_min_);
-    add(phi_max_);
-    for (int quarter = 0; quarter <= 8; ++quarter) {
-        const double phi = quarter * (kPi / 2.0);
-        if (phi >= phi_min_ && phi <= phi_max_) add(phi);
-    }
+    // The arc's box: a point of the side is (r sin phi, y, r cos phi).
+    double sin_lo, sin_hi, cos_lo, cos_hi;
+    azimuth_.sine_cosine_bounds(sin_lo, sin_hi, cos_lo, cos_hi);
+    const Aabb arc(Point3(radius_ * sin_lo, y_min_, radius_ * cos_lo),
+                   Point3(radius_ * sin_hi, y_max_, radius_ * cos_hi));
     // sin and cos are rounded, and hits are accepted on rounded azimuths: pad so the box
     // holds every point the queries can return.
     const Vector3 pad(16.0 * kUnitRoundoff * radius_, 0.0, 16.0 * kUnitRoundoff * radius_);
     bounds_ = Aabb(arc.lower - pad, arc.upper + pad);
-}
-
-bool PartCylinder::includes_azimuth(double phi) const {
-    return (phi >= phi_min_ && phi <= phi_max_) ||
-           (phi + kTwoPi >= phi_min_ && phi + kTwoPi <= phi_max_);
 }
 
 bool PartCylinder::nearest(const Ray& ray, double& t) const {
@@ -55,7 +40,7 @@ bool PartCylinder::nearest(const Ray& ray, double& t) const {
             continue;
         }
         const Point3 p = ray.at(end);
-        if (includes_azimuth(detail::azimuth(p.x(), p.z()))) {
+        if (azimuth_.contains(p.x(), p.z())) {
             t = end;
             return true;
         }
@@ -88,11 +73,9 @@ Hit PartCylinder::finish(const Ray& ray, const HitRecord& record) const {
     } else {
         hit.geometric_normal = Normal3(0.0, 0.0, 1.0);
     }
-    double phi = detail::azimuth(p.x(), p.z());
-    if (phi < phi_min_) phi += kTwoPi;
     hit.point = p;
     hit.shading_normal = hit.geometric_normal;
-    hit.uv = Vector2(std::clamp((phi - phi_min_) / (phi_max_ - phi_min_), 0.0, 1.0),
+    hit.uv = Vector2(azimuth_.fraction(AngleRange::azimuth(p.x(), p.z())),
                      std::clamp((p.y() - y_min_) / (y_max_ - y_min_), 0.0, 1.0));
     hit.shape = this;
     hit.primitive_id = record.primitive;

@@ -7,27 +7,6 @@
 
 namespace csgrt {
 
-AzimuthRange::AzimuthRange(double phi_min, double phi_max, std::string_view what)
-    : phi_min_(phi_min), phi_max_(phi_max) {
-    require(phi_min >= 0.0 && phi_min < kTwoPi, what, "phi_min", "in [0, 2 pi)", phi_min);
-    require(phi_max > phi_min && phi_max <= phi_min + kTwoPi, what, "phi_max",
-            "in (phi_min, phi_min + 2 pi]", phi_max);
-    extent_ = phi_max - phi_min;
-    // The same expression as the check above, so phi_min + 2 pi passed in is the full circle.
-    full_ = phi_max == phi_min + kTwoPi;
-}
-
-double AzimuthRange::azimuth(double x, double z) {
-    const double phi = std::atan2(x, z);
-    return phi < 0.0 ? phi + kTwoPi : phi;
-}
-
-double AzimuthRange::fraction(double phi) const {
-    const double offset = offset_from_min(phi);
-    if (offset <= extent_) return offset / extent_;
-    return offset - extent_ < kTwoPi - offset ? 1.0 : 0.0;
-}
-
 namespace {
 
 Sphere validated_sphere(const Point3& center, double radius) {
@@ -116,7 +95,7 @@ Hit PartSphere::finish(const Ray& ray, const HitRecord& record) const {
     hit.shading_normal = hit.geometric_normal;
     const double theta = std::acos(std::clamp(local.y() / r, -1.0, 1.0));
     const double v = (theta_max_ - theta) / (theta_max_ - theta_min_);
-    hit.uv = Vector2(azimuth_.fraction(AzimuthRange::azimuth(local.x(), local.z())),
+    hit.uv = Vector2(azimuth_.fraction(AngleRange::azimuth(local.x(), local.z())),
                      std::clamp(v, 0.0, 1.0));
     hit.shape = this;
     hit.primitive_id = record.primitive;

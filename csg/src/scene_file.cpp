@@ -576,8 +576,9 @@ std::vector<ShapePointer> Loader::grid(Fields& fields) {
             fields.fail("count",
                         "expected every count >= 1, got 0 at index " + std::to_string(axis));
         }
-        if (counts[axis] > kMaxGridCopies) total = kMaxGridCopies + 1;
-        total = std::min(total * counts[axis], kMaxGridCopies + 1);
+        // Both factors stay <= kMaxGridCopies + 1, so the product cannot overflow.
+        total = counts[axis] > kMaxGridCopies ? kMaxGridCopies + 1
+                                              : std::min(total * counts[axis], kMaxGridCopies + 1);
     }
     if (total > kMaxGridCopies) {
         fields.fail("count",
@@ -840,7 +841,7 @@ Scene Loader::load() {
         return found->second;
     };
     for (std::size_t i = 0; i < objects.size(); ++i) {
-        Fields fields(objects[i], child_pointer("/objects", i), source_, "an object");
+        Fields fields(objects[i], child_pointer("/objects", i), source_, "a scene object");
         const std::string name = fields.string("name", "");
         const bool is_grid = fields.has("type") && objects[i].at("type") == "grid";
         std::vector<std::uint32_t> palette;

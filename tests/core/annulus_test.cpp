@@ -184,8 +184,8 @@ TEST(Annulus, MatchesALongDoubleSolve) {
         const long double x = q.dot(annulus.frame().x_axis.cast<long double>());
         const long double z = q.dot(annulus.frame().z_axis.cast<long double>());
         const long double offset =
-            std::fmod(std::atan2(x, z) - annulus.azimuth().phi_min() + 2 * two_pi, two_pi);
-        const long double extent = annulus.azimuth().phi_max() - annulus.azimuth().phi_min();
+            std::fmod(std::atan2(x, z) - annulus.azimuth().min() + 2 * two_pi, two_pi);
+        const long double extent = annulus.azimuth().max() - annulus.azimuth().min();
         // Decided beyond double rounding only 1e-9 away from every limit.
         bool ambiguous = std::abs(t) < 1e-9L;
         for (const long double gap : {r - annulus.inner_radius(), annulus.outer_radius() - r,

@@ -88,9 +88,9 @@ TEST(PartCylinder, SeamAtZeroAndTwoPi) {
     EXPECT_EQ(across.intersect(Ray{Point3(1.5, 0, 0), Vector3(-1, 0, 0)})->t, 0.5);
     // Just on the negative side of the seam: atan2 gives a tiny negative angle that rounds to
     // 2 pi, which must count as 0.
-    EXPECT_EQ(detail::azimuth(-1e-300, 1.0), 0.0);
+    EXPECT_EQ(AngleRange::azimuth(-1e-300, 1.0), 0.0);
     EXPECT_TRUE(kQuarter.intersect(Ray{Point3(-1e-300, 0, 5), Vector3(0, 0, -1)}));
-    EXPECT_TRUE(kQuarter.includes_azimuth(kPi / 2));  // the other edge is included too
+    EXPECT_TRUE(kQuarter.azimuth().contains(kPi / 2));  // the other edge is included too
     EXPECT_TRUE(kQuarter.intersect(Ray{Point3(5, 0, 0), Vector3(-1, 0, 0)}));
 }
 
@@ -246,10 +246,10 @@ long double reference_t(const PartCylinder& part, const Ray& ray, long double& m
         const Real y = oy + t * dy;
         Real phi = std::atan2(ox + t * dx, oz + t * dz);
         if (phi < 0) phi += 2 * std::acos(-1.0L);
-        if (phi < part.phi_min()) phi += 2 * std::acos(-1.0L);
+        if (phi < part.azimuth().min()) phi += 2 * std::acos(-1.0L);
         margin = std::min({margin, std::abs(y - part.y_min()), std::abs(y - part.y_max()),
-                           std::abs(phi - part.phi_min()), std::abs(phi - part.phi_max())});
-        if (y >= part.y_min() && y <= part.y_max() && phi <= part.phi_max()) return t;
+                           std::abs(phi - part.azimuth().min()), std::abs(phi - part.azimuth().max())});
+        if (y >= part.y_min() && y <= part.y_max() && phi <= part.azimuth().max()) return t;
     }
     return INFINITY;
 }
@@ -289,7 +289,7 @@ void expect_matches_reference(const PartCylinder& part, double distance, std::ui
         // The hit honours the limits.
         EXPECT_GE(hit->point.y(), part.y_min());
         EXPECT_LE(hit->point.y(), part.y_max());
-        EXPECT_TRUE(part.includes_azimuth(detail::azimuth(hit->point.x(), hit->point.z())));
+        EXPECT_TRUE(part.azimuth().contains(AngleRange::azimuth(hit->point.x(), hit->point.z())));
     }
     EXPECT_GT(compared, 45000);
     EXPECT_GT(hits, distance > 0 ? 10000 : 5000);

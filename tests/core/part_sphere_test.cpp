@@ -45,8 +45,8 @@ void expect_within_limits(const PartSphere& part, const Point3& point, double sl
     if (phi < 0) phi += 2 * std::acos(-1.0L);
     // Offset from phi_min, reduced into [-pi, 3 pi) so both ends can be approached.
     const long double two_pi = 2 * std::acos(-1.0L);
-    long double offset = std::fmod(phi - part.azimuth().phi_min() + 2 * two_pi, two_pi);
-    const long double extent = part.azimuth().phi_max() - part.azimuth().phi_min();
+    long double offset = std::fmod(phi - part.azimuth().min() + 2 * two_pi, two_pi);
+    const long double extent = part.azimuth().max() - part.azimuth().min();
     const long double phi_slack = slack / rho + 1e-15L;
     if (offset > extent + phi_slack && offset > two_pi - phi_slack) offset -= two_pi;
     EXPECT_GE(offset, -phi_slack) << point.transpose();

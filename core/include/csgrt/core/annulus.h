@@ -1,6 +1,6 @@
 #pragma once
 
-#include "csgrt/core/part_sphere.h"
+#include "csgrt/core/angle_range.h"
 #include "csgrt/core/plane.h"
 #include "csgrt/core/shape.h"
 
@@ -8,7 +8,7 @@ namespace csgrt {
 
 /// The part disk / annulus: points of the plane through `center` with normal `normal`
 /// (normalised) at distance r in [inner_radius, outer_radius] from the center and azimuth phi
-/// in [phi_min, phi_max] (AzimuthRange rules: may wrap past 2 pi). phi = atan2(x, z) is
+/// in [phi_min, phi_max] (AngleRange rules: may wrap past 2 pi). phi = atan2(x, z) is
 /// measured in `frame()`, so for normal +y it is the y-up azimuth. inner_radius 0 gives a part
 /// disk, the full range [0, 2 pi] a plain annulus. Not a solid.
 ///
@@ -37,7 +37,7 @@ public:
     const SurfaceFrame& frame() const { return frame_; }
     double inner_radius() const { return inner_radius_; }
     double outer_radius() const { return outer_radius_; }
-    const AzimuthRange& azimuth() const { return azimuth_; }
+    const AngleRange& azimuth() const { return azimuth_; }
 
 private:
     bool crossing(const Ray& ray, double& t) const;
@@ -46,7 +46,7 @@ private:
     SurfaceFrame frame_;
     double inner_radius_;
     double outer_radius_;
-    AzimuthRange azimuth_;
+    AngleRange azimuth_;
 };
 
 }  // namespace csgrt

@@ -89,9 +89,6 @@ LineInterval overlap(const LineInterval& a, const LineInterval& b);
 bool nearest_open_surface_hit(const Ray& ray, const LineInterval& side, const LineInterval& slab,
                               double& t, std::uint32_t& surface);
 
-/// Azimuth atan2(x, z) wrapped to [0, 2 pi).
-double azimuth(double x, double z);
-
 }  // namespace detail
 
 }  // namespace csgrt

@@ -1,5 +1,6 @@
 #pragma once
 
+#include "csgrt/core/angle_range.h"
 #include "csgrt/core/shape.h"
 
 namespace csgrt {
@@ -29,14 +30,11 @@ public:
     bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
 
-    /// Whether azimuth phi (any value in [0, 2 pi)) lies in [phi_min, phi_max], seam included.
-    bool includes_azimuth(double phi) const;
-
     double radius() const { return radius_; }
     double y_min() const { return y_min_; }
     double y_max() const { return y_max_; }
-    double phi_min() const { return phi_min_; }
-    double phi_max() const { return phi_max_; }
+    /// The azimuth limits [phi_min, phi_max], seam included.
+    const AngleRange& azimuth() const { return azimuth_; }
 
 private:
     bool nearest(const Ray& ray, double& t) const;
@@ -44,8 +42,7 @@ private:
     double radius_;
     double y_min_;
     double y_max_;
-    double phi_min_;
-    double phi_max_;
+    AngleRange azimuth_;
     Aabb bounds_;
 };
 
