@@ -8,6 +8,7 @@
 #include <sstream>
 #include <vector>
 
+#include "csgrt/accel/mesh.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
@@ -269,6 +270,10 @@ public:
 
     ShapePointer definition(const std::string& name, const std::string& pointer);
 
+    /// A mesh node: the file at "path", relative to the scene file's folder, loaded once per
+    /// path and settings however often it is named.
+    ShapePointer mesh(Fields& fields);
+
     const Source& source() const { return source_; }
 
     Transform transform(const Json& list, const std::string& pointer) const;
@@ -282,6 +287,7 @@ private:
     const Source& source_;
     const Json* definitions_ = nullptr;
     std::map<std::string, ShapePointer> built_;
+    std::map<std::string, ShapePointer> meshes_;
     /// Definitions being built, outermost first: a name met again here is a cycle.
     std::vector<std::string> building_;
 };
@@ -297,10 +303,12 @@ ShapePointer place(ShapePointer shape, const Transform& world_from_object) {
 }
 
 std::string solid_requirement(const ListItem& item) {
+    std::string kind(item.shape->kind());
+    if (kind == "mesh") kind = "an open mesh (one with a boundary, not a closed surface)";
     return "expected a solid (a closed shape: sphere, box, capped cylinder or cone, torus, "
            "boolean, ready-made solid, compound of solids, closed mesh) as a boolean operand, "
            "got " +
-           std::string(item.shape->kind());
+           kind;
 }
 
 std::vector<ShapePointer> operand_shapes(const std::vector<ListItem>& items, const Source& source) {
@@ -404,6 +412,23 @@ const ShapeEntry kShapeTable[] = {
                                           f.degrees("phi_max", 360.0));
      },
      true},
+    {"torus",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const double major_radius = f.number("major_radius");
+         return std::make_shared<Torus>(major_radius, f.number("minor_radius"));
+     }},
+    {"part_torus",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const double major_radius = f.number("major_radius");
+         const double minor_radius = f.number("minor_radius");
+         const double phi_min = f.degrees("phi_min", 0.0);
+         const double phi_max = f.degrees("phi_max", 360.0);
+         const double theta_min = f.degrees("theta_min", 0.0);
+         return std::make_shared<PartTorus>(major_radius, minor_radius, phi_min, phi_max, theta_min,
+                                            f.degrees("theta_max", 360.0));
+     },
+     true},
+    {"mesh", [](Fields& f, Loader& loader) -> ShapePointer { return loader.mesh(f); }},
     {"solid_cylinder",
      [](Fields& f, Loader&) -> ShapePointer {
          const Point3 bottom = f.vector("bottom");
@@ -468,13 +493,6 @@ const ShapeEntry kShapeTable[] = {
     {"ref",
      [](Fields& f, Loader& loader) -> ShapePointer {
          return loader.definition(f.string("definition"), f.pointer("definition"));
-     }},
-    {"mesh",
-     [](Fields& f, Loader&) -> ShapePointer {
-         f.string("path");
-         f.fail("",
-                "meshes are not available in this build (the mesh loader is not part of "
-                "it yet)");
      }},
 };
 
@@ -639,6 +657,29 @@ ShapePointer Loader::definition(const std::string& name, const std::string& poin
     building_.pop_back();
     built_[name] = built;
     return built;
+}
+
+ShapePointer Loader::mesh(Fields& fields) {
+    const std::string path = fields.string("path");
+    MeshConfig config;
+    config.double_precision = fields.boolean("double_precision", false);
+    config.accelerator = fields.string("accelerator", config.accelerator);
+    const std::filesystem::path file = source_.directory / path;
+    const std::string key = file.lexically_normal().string() + "|" +
+                            (config.double_precision ? "double" : "float") + "|" +
+                            config.accelerator;
+    if (const auto found = meshes_.find(key); found != meshes_.end()) return found->second;
+    ShapePointer loaded;
+    try {
+        loaded = Mesh::load(file, config);
+    } catch (const MeshError& error) {
+        fields.fail("path", std::string("cannot use the mesh: ") + error.what());
+    } catch (const InvalidParameter& error) {
+        // An unknown structure name.
+        fields.fail("accelerator", error.what());
+    }
+    meshes_[key] = loaded;
+    return loaded;
 }
 
 Transform Loader::transform(const Json& list, const std::string& pointer) const {

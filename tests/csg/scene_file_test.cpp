@@ -19,6 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const fs::path kScenes = fs::path(CSGRT_SOURCE_DIR) / "data" / "scenes";
+const fs::path kMeshes = fs::path(CSGRT_SOURCE_DIR) / "tests" / "data" / "meshes";
 const fs::path kBroken = fs::path(CSGRT_SOURCE_DIR) / "tests" / "data" / "scenes" / "broken";
 
 std::string error_of(std::string_view text) {
@@ -120,7 +121,7 @@ TEST(SceneFile, EveryShippedSceneLoadsCommitsAndIsSeen) {
 }
 
 TEST(SceneFile, EveryShapeTypeLoads) {
-    const Scene scene = load(R"({
+    const Scene scene = load_scene_from_string(R"({
       "objects": [
         {"type": "sphere", "center": [1, 2, 3], "radius": 0.5},
         {"type": "plane", "normal": [0, 1, 0]},
@@ -148,44 +149,52 @@ TEST(SceneFile, EveryShapeTypeLoads) {
         {"type": "compound", "children": [{"type": "sphere", "radius": 1},
                                           {"type": "plane", "normal": [0, 1, 0]}]},
         {"type": "grid", "count": [2, 2, 1], "spacing": [3, 3, 0], "item": {"type": "sphere", "radius": 1}},
-        {"type": "ref", "definition": "ball"}
+        {"type": "ref", "definition": "ball"},
+        {"type": "torus", "major_radius": 1, "minor_radius": 0.25},
+        {"type": "part_torus", "major_radius": 1, "minor_radius": 0.25, "phi_max": 270,
+         "theta_min": 270, "theta_max": 450},
+        {"type": "mesh", "path": "box.off"},
+        {"type": "difference", "operands": [{"type": "mesh", "path": "box.off"},
+                                            {"type": "sphere", "radius": 1}]}
       ],
       "definitions": {"ball": {"type": "sphere", "radius": 0.25}}
-    })");
+    })",
+                                               "test.json", kMeshes);
     std::vector<std::string_view> kinds;
     for (const SceneObject& object : scene.objects()) kinds.push_back(object.shape->kind());
+    // clang-format off
     const std::vector<std::string_view> expected = {
-        "sphere",   "plane",        "triangle",     "disk",          "rectangle", "box",
-        "cylinder", "cone",         "part_sphere",  "part_cylinder", "annulus",   "instance",
-        "instance", "difference",   "intersection", "union",  // ready-made solids
-        "union",    "intersection", "difference",   "compound",      "instance",  "instance",
-        "instance", "instance",  // the grid's copies
-        "sphere"};               // the definition itself
+        "sphere", "plane", "triangle", "disk", "rectangle", "box", "cylinder", "cone",
+        "part_sphere", "part_cylinder", "annulus",
+        "instance", "instance", "difference", "intersection", "union",  // ready-made solids
+        "union", "intersection", "difference", "compound",
+        "instance", "instance", "instance", "instance",  // the grid's copies
+        "sphere",                                        // the definition itself
+        "torus", "part_torus", "mesh", "difference"};
     EXPECT_EQ(kinds, expected);
-    // Every type of the table is used above, except "mesh".
-    std::set<std::string_view> used = {"sphere",      "plane",
-                                       "triangle",    "disk",
-                                       "rectangle",   "box",
-                                       "cylinder",    "cone",
-                                       "part_sphere", "part_cylinder",
-                                       "annulus",     "solid_cylinder",
-                                       "solid_cone",  "thick_ring",
-                                       "bowl",        "rounded_box",
-                                       "union",       "intersection",
-                                       "difference",  "compound",
-                                       "grid",        "ref"};
+    // Every type of the table is used above.
+    const std::set<std::string_view> used = {
+        "sphere", "plane", "triangle", "disk", "rectangle", "box", "cylinder", "cone",
+        "part_sphere", "part_cylinder", "annulus", "torus", "part_torus", "mesh",
+        "solid_cylinder", "solid_cone", "thick_ring", "bowl", "rounded_box",
+        "union", "intersection", "difference", "compound", "grid", "ref"};
+    // clang-format on
     for (std::string_view type : scene_shape_types()) {
-        EXPECT_TRUE(used.contains(type) || type == "mesh") << type << " is not tested here";
+        EXPECT_TRUE(used.contains(type)) << type << " is not tested here";
     }
     // Angles are degrees: phi_min 90 is pi / 2.
     const auto& part = static_cast<const PartSphere&>(*scene.objects()[8].shape);
-    EXPECT_DOUBLE_EQ(part.azimuth().phi_min(), kPi / 2);
+    EXPECT_DOUBLE_EQ(part.azimuth().min(), kPi / 2);
     EXPECT_DOUBLE_EQ(part.theta_max(), kPi / 2);
     const auto& cylinder = static_cast<const Cylinder&>(*scene.objects()[6].shape);
     EXPECT_TRUE(cylinder.capped());  // the documented default
     const auto& cone = static_cast<const Cone&>(*scene.objects()[7].shape);
     EXPECT_FALSE(cone.capped());
     EXPECT_EQ(cone.top_radius(), 0.0);
+    // One mesh file named twice is loaded once; a closed mesh is a CSG operand.
+    const auto& bitten = static_cast<const Boolean&>(*scene.objects()[28].shape);
+    EXPECT_EQ(&bitten.first(), scene.objects()[27].shape.get());
+    EXPECT_TRUE(scene.objects()[27].shape->is_solid());
 }
 
 TEST(SceneFile, TransformsApplyInListOrder) {
