@@ -36,6 +36,8 @@ install(EXPORT csgrtTargets NAMESPACE csgrt:: DESTINATION ${CSGRT_INSTALL_CMAKED
 # libraries carry their private dependencies to the final link). Each entry maps a prefix of
 # the imported target names to the find_package arguments that provide it; a dependency that
 # is added to a layer and missing here makes the install test fail at the consumer's configure.
+# OpenMesh is asked for its CONFIG package: CGAL's config puts a FindOpenMesh.cmake module on
+# the path that does not find Debian's OpenMesh.
 set(CSGRT_KNOWN_DEPENDENCIES
     "Eigen3::|Eigen3 3.4 NO_MODULE"
     "Threads::|Threads"
@@ -45,7 +47,7 @@ set(CSGRT_KNOWN_DEPENDENCIES
     "PNG::|PNG"
     "CLI11::|CLI11"
     "nlohmann_json::|nlohmann_json"
-    "OpenMesh|OpenMesh"
+    "OpenMesh|OpenMesh CONFIG"
     "embree|embree 3")
 set(CSGRT_FIND_DEPENDENCIES "")
 set(linked "")
