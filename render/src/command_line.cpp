@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "csgrt/accel/mesh.h"
 #include "csgrt/core/instance.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/compound.h"
@@ -206,22 +207,30 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
 }
 
 /// Counts every shape in the tree under `shape` by kind(), descending through instances,
-/// booleans and compounds; a shape shared by several parents counts once per use.
-void count_kinds(const Shape& shape, std::map<std::string, std::size_t>& counts) {
+/// booleans and compounds; a shape shared by several parents counts once per use. Meshes add
+/// their triangles to `triangles`.
+void count_kinds(const Shape& shape, std::map<std::string, std::size_t>& counts,
+                 std::size_t& triangles) {
     const std::string_view kind = shape.kind();
     ++counts[std::string(kind)];
-    if (kind == "instance") {
+    if (kind == "mesh") {
+        if (const auto* mesh = dynamic_cast<const Mesh*>(&shape)) {
+            triangles += mesh->triangle_count();
+        }
+    } else if (kind == "instance") {
         if (const auto* instance = dynamic_cast<const Instance*>(&shape)) {
-            count_kinds(instance->shape(), counts);
+            count_kinds(instance->shape(), counts, triangles);
         }
     } else if (kind == "union" || kind == "intersection" || kind == "difference") {
         if (const auto* node = dynamic_cast<const Boolean*>(&shape)) {
-            count_kinds(node->first(), counts);
-            count_kinds(node->second(), counts);
+            count_kinds(node->first(), counts, triangles);
+            count_kinds(node->second(), counts, triangles);
         }
     } else if (kind == "compound") {
         if (const auto* compound = dynamic_cast<const Compound*>(&shape)) {
-            for (const auto& child : compound->children()) count_kinds(*child, counts);
+            for (const auto& child : compound->children()) {
+                count_kinds(*child, counts, triangles);
+            }
         }
     }
 }
@@ -237,9 +246,9 @@ void info_command(const std::string& scene_path, CommandLineStreams streams) {
     Scene scene = load_checked(scene_path);
     scene.commit();  // "auto": what a render without --accel would build
     std::map<std::string, std::size_t> counts;
-    std::size_t unbounded = 0;
+    std::size_t unbounded = 0, triangles = 0;
     for (const SceneObject& object : scene.objects()) {
-        count_kinds(*object.shape, counts);
+        count_kinds(*object.shape, counts, triangles);
         if (!object.shape->bounds().is_finite()) ++unbounded;
     }
     std::size_t shapes = 0;
@@ -250,8 +259,10 @@ void info_command(const std::string& scene_path, CommandLineStreams streams) {
         << " unbounded), " << shapes << " shapes in the trees under them:\n";
     for (const auto& [kind, count] : counts) {
         char row[96];
-        std::snprintf(row, sizeof(row), "  %-18s %zu\n", kind.c_str(), count);
+        std::snprintf(row, sizeof(row), "  %-18s %zu", kind.c_str(), count);
         out << row;
+        if (kind == "mesh") out << " (" << triangles << " triangles in all)";
+        out << '\n';
     }
     std::size_t point_lights = 0;
     for (const Light& light : scene.lights())

@@ -259,6 +259,24 @@ TEST_F(CommandLine, InfoCountsKindsThroughTheTree) {
     }
 }
 
+TEST_F(CommandLine, InfoReportsTheShowcasesMeshWithItsTriangleCount) {
+    // The triangle count from the OFF file's header ("OFF", then vertices faces edges), read
+    // here independently of the mesh loader; the knot is all triangles.
+    const fs::path scenes = fs::path(CSGRT_SOURCE_DIR) / "data" / "scenes";
+    std::ifstream off(scenes / "meshes" / "trefoil.off");
+    std::string magic;
+    std::size_t vertices = 0, faces = 0;
+    off >> magic >> vertices >> faces;
+    ASSERT_EQ(magic, "OFF");
+    ASSERT_GT(faces, 100u);
+    const ProgramRun result = run({"info", (scenes / "showcase.json").string()});
+    ASSERT_EQ(result.status, 0) << result.err;
+    EXPECT_NE(result.out.find("  mesh               1 (" + std::to_string(faces) +
+                              " triangles in all)\n"),
+              std::string::npos)
+        << result.out;
+}
+
 TEST_F(CommandLine, HelpAndVersionSucceed) {
     const ProgramRun help = run({"--help"});
     EXPECT_EQ(help.status, 0);
