@@ -67,7 +67,7 @@ std::uint32_t classify(const TriangleSet<Real>& set, std::size_t i,
     const Real determinant = u + v + w;
     // The sheared frame maps the direction to +z scaled by 1/d_z, so the 2D winding seen from
     // the ray, corrected by the sign of d_z, tells entering (d . n < 0) from leaving.
-    const bool entering = (determinant > Real(0)) == (ray.shear_z > Real(0));
+    const bool entering = (determinant > Real(0)) == (ray.shear_z > 0.0);
     std::uint32_t flags = entering ? kEntering : 0;
     bool counted = true;
     auto tie = [&](Real edge, Real px, Real py, Real qx, Real qy) {

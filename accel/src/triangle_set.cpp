@@ -41,7 +41,7 @@ typename TriangleSet<Real>::PreparedRay TriangleSet<Real>::prepare(const Ray& ra
     prepared.axis_y = (prepared.axis_x + 1) % 3;
     // The ratios are formed in double and rounded once.
     const Vector3& direction = ray.direction;
-    prepared.shear_z = static_cast<Real>(1.0 / direction[prepared.axis_z]);
+    prepared.shear_z = 1.0 / direction[prepared.axis_z];
     prepared.shear_x = static_cast<Real>(direction[prepared.axis_x] / direction[prepared.axis_z]);
     prepared.shear_y = static_cast<Real>(direction[prepared.axis_y] / direction[prepared.axis_z]);
     prepared.t_min = ray.t_min;
@@ -79,12 +79,13 @@ bool TriangleSet<Real>::hit(std::size_t i, const PreparedRay& ray, double& t, do
     if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return false;
     const Real determinant = u + v + w;
     if (determinant == Real(0)) return false;  // edge-on or degenerate
-    const Real az = ray.shear_z * a[kz], bz = ray.shear_z * b[kz], cz = ray.shear_z * d[kz];
-    const Real scaled_t = u * az + v * bz + w * cz;
+    // Woop's T = U Az + V Bz + W Cz with the shear 1 / d_z factored out of the sum and applied
+    // in double, so that t is right for any valid |d| (float would overflow at 1 / 1e-150).
+    const Real scaled_t = u * a[kz] + v * b[kz] + w * d[kz];
     // The division happens only for triangles the ray crosses; comparing t itself (not the
     // scaled form) keeps the tie rule exact.
     const double inverse = 1.0 / double(determinant);
-    t = double(scaled_t) * inverse;
+    t = double(scaled_t) * (ray.shear_z * inverse);
     b1 = double(v) * inverse;
     b2 = double(w) * inverse;
     return true;

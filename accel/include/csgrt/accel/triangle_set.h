@@ -24,11 +24,15 @@ public:
     using Vector = Eigen::Matrix<Real, 3, 1>;
 
     /// The ray in the triangle test's frame: origin, the permutation that makes z the dominant
-    /// direction axis, and the shear that maps the direction to (0, 0, 1).
+    /// direction axis, and the shear that maps the direction to (0, 0, 1). shear_x and shear_y
+    /// are ratios of direction components (scale-free, so they fit Real for any valid ray);
+    /// shear_z = 1 / d_z stays in double, where a direction of length 1e-150 or 1e150 (valid,
+    /// see is_valid) does not overflow or underflow as it would in float.
     struct PreparedRay {
         Vector origin;
         int axis_x, axis_y, axis_z;
-        Real shear_x, shear_y, shear_z;
+        Real shear_x, shear_y;
+        double shear_z;
         double t_min, t_max;
     };
 
