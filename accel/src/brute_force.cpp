@@ -63,7 +63,7 @@ template <class Set>
 template <bool kCount>
 bool BruteForce<Set>::intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
                                      TraversalCounters& counters) const {
-    if (set_ == nullptr) return false;
+    if (set_ == nullptr || !is_valid(ray)) return false;
     const auto prepared = set_->prepare(ray, scratch);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     HitRecord best;
@@ -83,7 +83,7 @@ template <class Set>
 template <bool kCount>
 bool BruteForce<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
                                     TraversalCounters& counters) const {
-    if (set_ == nullptr) return false;
+    if (set_ == nullptr || !is_valid(ray)) return false;
     const auto prepared = set_->prepare(ray, scratch);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     for (std::size_t i = 0; i < set_->size(); ++i) {
@@ -98,7 +98,7 @@ bool BruteForce<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
 template <class Set>
 void BruteForce<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
                                QueryScratch& scratch) const {
-    if (set_ == nullptr) return;
+    if (set_ == nullptr || !is_valid(ray)) return;
     const auto prepared = set_->prepare(ray, scratch);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     for (std::size_t i = 0; i < set_->size(); ++i) {

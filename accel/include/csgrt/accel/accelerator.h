@@ -49,8 +49,8 @@ public:
     /// The factory name: "brute", "grid", "hgrid", "rayclass" or "bvh".
     virtual std::string_view name() const = 0;
 
-    /// Nearest hit in [ray.t_min, ray.t_max] (ray assumed valid). On success writes the set's
-    /// fields of `record` (t, primitive or object, u, v) and returns true.
+    /// Nearest hit in [ray.t_min, ray.t_max] (an invalid ray, see is_valid, never hits). On success
+    /// writes the set's fields of `record` (t, primitive or object, u, v) and returns true.
     virtual bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const = 0;
     /// Whether any primitive is hit in [ray.t_min, ray.t_max]; stops at the first.
     virtual bool occluded(const Ray& ray, QueryScratch& scratch) const = 0;
