@@ -86,16 +86,14 @@ bool PartSphere::any_hit(const Ray& ray, QueryScratch&) const {
 Hit PartSphere::finish(const Ray& ray, const HitRecord& record) const {
     Hit hit;
     hit.t = record.t;
-    const double r = radius();
-    Vector3 local = (ray.origin - center()) + record.t * ray.direction;
     // Project back onto the sphere, as Sphere::finish does.
-    local *= r / local.norm();
-    hit.point = center() + local;
-    hit.geometric_normal = local / r;
+    const Normal3 normal = sphere_.unit_along((ray.origin - center()) + record.t * ray.direction);
+    hit.point = center() + radius() * normal;
+    hit.geometric_normal = normal;
     hit.shading_normal = hit.geometric_normal;
-    const double theta = std::acos(std::clamp(local.y() / r, -1.0, 1.0));
+    const double theta = std::acos(std::clamp(normal.y(), -1.0, 1.0));
     const double v = (theta_max_ - theta) / (theta_max_ - theta_min_);
-    hit.uv = Vector2(azimuth_.fraction(AngleRange::azimuth(local.x(), local.z())),
+    hit.uv = Vector2(azimuth_.fraction(AngleRange::azimuth(normal.x(), normal.z())),
                      std::clamp(v, 0.0, 1.0));
     hit.shape = this;
     hit.primitive_id = record.primitive;

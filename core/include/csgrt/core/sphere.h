@@ -27,12 +27,22 @@ public:
     const Point3& center() const { return center_; }
     double radius() const { return radius_; }
 
-    /// Both roots t0 <= t1 of the ray's line with the sphere, or false when it misses.
+    /// Both roots t0 <= t1 of the ray's line with the sphere, or false when it misses. Any
+    /// radius and direction length a double holds: extreme ones are rescaled by powers of two.
     bool line_roots(const Ray& ray, double& t0, double& t1) const;
+    /// The unit vector along `offset` (a point minus the center), computed without underflow
+    /// or overflow for offsets of the sphere's size, however tiny or huge that is.
+    Normal3 unit_along(const Vector3& offset) const { return (offset * scale_).normalized(); }
 
 private:
     Point3 center_;
     double radius_;
+    /// 2^-e with radius * scale in [1, 2): exact rescaling to a unit-sized sphere.
+    double scale_;
+    int exponent_;
+    /// Whether the radius is in [2^-200, 2^200], where its square and products with squared
+    /// direction lengths in [2^-400, 2^400] stay normal doubles (the fast path of line_roots).
+    bool moderate_;
 };
 
 }  // namespace csgrt
