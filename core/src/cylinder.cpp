@@ -193,9 +193,12 @@ Hit Cylinder::finish(const Ray& ray, const HitRecord& record) const {
         // Project radially onto the side, which removes the rounding of o + t d along the
         // normal; a point on the axis (impossible for a true side hit) keeps a fixed normal.
         if (distance > 0.0) {
-            p.x() *= radius_ / distance;
-            p.z() *= radius_ / distance;
-            hit.geometric_normal = Normal3(p.x(), 0.0, p.z()).normalized();
+            // The unit radial direction first: normalising p itself would underflow for a
+            // radius of 1e-300 (hypot does not).
+            const Normal3 radial(p.x() / distance, 0.0, p.z() / distance);
+            p.x() = radius_ * radial.x();
+            p.z() = radius_ * radial.z();
+            hit.geometric_normal = radial.normalized();
         } else {
             hit.geometric_normal = Normal3(0.0, 0.0, 1.0);
         }
