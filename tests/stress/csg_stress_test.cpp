@@ -20,6 +20,7 @@
 #include "csgrt/csg/boolean.h"
 #include "stress/reference_shapes.h"
 #include "stress/stress_config.h"
+#include "stress/summary.h"
 #include "support/meshes.h"
 #include "support/random.h"
 
@@ -105,6 +106,7 @@ TEST(CsgStress, CoincidentOperandsAtEveryScale) {
         std::printf("  | %s | %ld | %ld | %ld | %ld |\n", name.c_str(), total, hits, speckles,
                     different);
         EXPECT_GT(hits, total / 5) << name;
+        test::summarize(name + " with itself", total, speckles + different);
     }
 }
 
@@ -167,6 +169,8 @@ TEST(CsgStress, BoxesTilingABoxAreThatBox) {
         EXPECT_GT(hits, rays / 2);
         EXPECT_GT(along_planes, rays / 10);
     }
+    test::summarize("27 boxes tiling a box, and the box cut",
+                    2L * rays * static_cast<long>(std::size(kScales)), test::failed_assertions());
 }
 
 TEST(CsgStress, ThinShellsAndGapsAroundTheCoincidenceTolerance) {
@@ -222,6 +226,9 @@ TEST(CsgStress, ThinShellsAndGapsAroundTheCoincidenceTolerance) {
             }
         }
     }
+    // 3 scales x 6 thicknesses x 1000 rays, each from the centre and from outside.
+    test::summarize("thin shells around the coincidence tolerance", 3L * 6 * 1000 * 2,
+                    test::failed_assertions());
 }
 
 // ----- Point membership classification in long double ---------------------------------------
@@ -473,6 +480,7 @@ TEST(CsgStress, DeepTreesAgreeWithPointMembership) {
                 total, judged, hits, skipped, span_checks);
     EXPECT_GT(hits, judged / 5);
     EXPECT_LT(skipped, total / 20);
+    test::summarize("depth-20 trees vs membership", judged, test::failed_assertions());
 }
 
 TEST(CsgStress, NearlyTangentSpheres) {
@@ -554,6 +562,7 @@ TEST(CsgStress, NearlyTangentSpheres) {
     std::printf("  nearly tangent spheres: %ld rays judged, %ld skipped\n", judged, skipped);
     // Rays aimed within 1e-7 sizes of the contact point are often ambiguous by design.
     EXPECT_GT(judged, 3 * skipped);
+    test::summarize("nearly tangent spheres vs membership", judged, test::failed_assertions());
 }
 
 }  // namespace

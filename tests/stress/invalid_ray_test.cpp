@@ -29,6 +29,7 @@
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
+#include "stress/summary.h"
 #include "support/meshes.h"
 #include "support/random.h"
 
@@ -232,6 +233,7 @@ TEST(InvalidRays, EveryShapeRejectsThemWithoutCrashingOrHanging) {
     }
     std::printf("  %ld queries on %zu invalid and %zu extreme rays\n", queries, invalid.size(),
                 extreme.size());
+    test::summarize("every shape: invalid and extreme rays", queries, test::failed_assertions());
 }
 
 TEST(InvalidRays, TinyAndHugeValidDirectionsGiveTheSameHitPoint) {
@@ -242,6 +244,7 @@ TEST(InvalidRays, TinyAndHugeValidDirectionsGiveTheSameHitPoint) {
     // on or inside every shape here (the thin torus included), the other half anywhere in the
     // unit cube; 200 rays a shape.
     test::Random random(17);
+    long total = 0;
     for (const auto& shape : every_shape()) {
         const std::string name = shape_name(*shape);
         int compared = 0;
@@ -270,7 +273,10 @@ TEST(InvalidRays, TinyAndHugeValidDirectionsGiveTheSameHitPoint) {
         // Each hit counts at both lengths: over 60 means at least 30 of the 200 rays hit (the
         // flat shapes catch few of those aimed at the circle).
         EXPECT_GT(compared, 60) << name;
+        total += compared;
     }
+    test::summarize("every shape: direction length 2^-500 and 2^500 vs 1", total,
+                    test::failed_assertions());
 }
 
 TEST(InvalidRays, EveryStructureRejectsThemOnEverySet) {
@@ -310,6 +316,9 @@ TEST(InvalidRays, EveryStructureRejectsThemOnEverySet) {
         check(*make_accelerator(name, double_set), std::string(name) + " double");
         check(*make_accelerator(name, shape_set), std::string(name) + " shapes");
     }
+    test::summarize("every structure: invalid rays",
+                    static_cast<long>(5 * 3 * invalid.size() * accelerator_names().size()),
+                    test::failed_assertions());
 }
 
 }  // namespace

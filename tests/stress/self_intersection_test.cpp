@@ -23,6 +23,7 @@
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
 #include "stress/stress_config.h"
+#include "stress/summary.h"
 #include "support/meshes.h"
 #include "support/random.h"
 
@@ -237,6 +238,7 @@ TEST(SelfIntersection, SecondaryRaysNeverRehitTheSurfaceTheyLeave) {
         std::printf("  | %s | %ld | %ld | %ld | %ld |\n", name.c_str(), t.primaries, t.leaving,
                     t.entering, t.self_hits);
         EXPECT_EQ(t.self_hits, 0) << name;
+        test::summarize(name, t.leaving + t.entering, t.self_hits);
         EXPECT_GT(t.primaries, primaries / 2) << name;  // of 6 x primaries aimed at the bounds
     }
 }

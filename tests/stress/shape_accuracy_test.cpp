@@ -34,6 +34,7 @@
 #include "csgrt/core/shapes.h"
 #include "stress/reference_shapes.h"
 #include "stress/stress_config.h"
+#include "stress/summary.h"
 #include "support/random.h"
 
 namespace csgrt {
@@ -520,6 +521,7 @@ TEST(ShapeAccuracy, EveryShapeAtEveryScaleAgainstLongDouble) {
             t.max_ratio);
         total.add(t);
         EXPECT_EQ(t.failures(), 0) << kind;
+        test::summarize(kind, t.rays, t.failures(), t.max_relative_error, "rel t");
         // Rays in the ambiguity bands are few except for the grazing set (1/7 of the rays);
         // thin tori are hit by few of the rays aimed at their bounds.
         EXPECT_LT(t.ambiguous, t.rays / 7) << kind;
@@ -605,6 +607,7 @@ TEST(ShapeAccuracy, ComplementaryPartsLeaveNoCrackAtSeamsAndLimits) {
     const int rays = 500 * test::stress_multiplier();
     std::printf("  | family | rays | full hits | hits at limits seen by both parts |\n");
     for (const PartFamily& family : part_families()) {
+        const long failed_before = test::failed_assertions();
         long checked = 0, full_hits = 0, both = 0;
         for (const auto& range : ranges) {
             const double a = range[0], b = range[1];
@@ -649,6 +652,7 @@ TEST(ShapeAccuracy, ComplementaryPartsLeaveNoCrackAtSeamsAndLimits) {
         }
         std::printf("  | %s | %ld | %ld | %ld |\n", family.name.c_str(), checked, full_hits, both);
         EXPECT_GT(full_hits, checked / 2) << family.name;
+        test::summarize(family.name + " seams", checked, test::failed_assertions() - failed_before);
     }
 }
 
@@ -691,6 +695,8 @@ TEST(ShapeAccuracy, TorusAlongAndBesideItsAxis) {
             }
         }
     }
+    // 3 scales x 3 thinnesses x 2 distances x 2 sides x 2 rays.
+    test::summarize("torus along and beside its axis", 72, test::failed_assertions());
 }
 
 }  // namespace

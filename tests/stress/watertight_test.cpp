@@ -24,6 +24,7 @@
 #include "csgrt/accel/mesh_tools.h"
 #include "csgrt/accel/triangle_set.h"
 #include "stress/stress_config.h"
+#include "stress/summary.h"
 #include "support/meshes.h"
 #include "support/random.h"
 #include "support/real_meshes.h"
@@ -211,6 +212,7 @@ TEST(Watertight, NoRayFromInsideAClosedMeshEscapesAnyStructure) {
                             tally.rays, tally.aimed_at_vertices, tally.aimed_at_edges,
                             tally.escapes);
                 EXPECT_EQ(tally.escapes, 0) << label << " " << precision;
+                test::summarize(label + " " + precision, tally.rays, tally.escapes);
             }
         }
     }
@@ -253,6 +255,8 @@ TEST(Watertight, IntegerCubeFromHalfIntegerPointsAtEveryVertexAndEdge) {
             }
         }
         EXPECT_EQ(escapes, 0) << name << " over " << rays << " queries";
+        test::summarize("integer_cube(6) " + std::string(name) + " vertices and edges", rays,
+                        escapes);
     }
 }
 
@@ -285,6 +289,8 @@ TEST(Watertight, OpenDragonAgreesWithExactPredicatesAtVerticesAndEdges) {
         }
         tally.print("dragon " + std::string(name) + " float");
         EXPECT_EQ(tally.clear, 0) << name;
+        test::summarize("dragon " + std::string(name) + " float vs CGAL", tally.rays, tally.clear,
+                        tally.max_relative_t_error, "rel t");
         EXPECT_GT(tally.hits, count / 2) << name;
     }
 }
