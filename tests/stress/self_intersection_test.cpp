@@ -3,11 +3,8 @@
 // to 1e6, for analytic shapes, instances, CSG and float and double meshes. The origin is moved
 // off the surface as in Waechter and Binder, "A Fast and Robust Method for Avoiding
 // Self-Intersection" (Ray Tracing Gems, 2019, ch. 6): by a distance proportional to the
-// magnitude of the point's coordinates.
-//
-// The renderer's offset (render/shadow_offset.h, branch render) is not on main yet; until it
-// is, `offset_ray_origin` below is a copy of its rule with the same signature, to be replaced
-// by the library function when it lands.
+// magnitude of the point's coordinates. The offset tested is the renderer's own, offset_ray_origin
+// (render/shadow_offset.h).
 
 #include <gtest/gtest.h>
 
@@ -22,6 +19,7 @@
 #include "csgrt/accel/mesh.h"
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
+#include "csgrt/render/shadow_offset.h"
 #include "stress/stress_config.h"
 #include "stress/summary.h"
 #include "support/meshes.h"
@@ -29,21 +27,6 @@
 
 namespace csgrt {
 namespace {
-
-/// The distance the origin moves: 2^-16 of the largest coordinate magnitude of the point
-/// (256 float ulps, Waechter and Binder's int_scale, so float meshes are cleared too), with a
-/// floor of 2^-10 of the scene's magnitude near the world origin (their `origin()` threshold,
-/// made relative).
-double ray_offset_distance(const Point3& p, double scene_magnitude) {
-    const double magnitude =
-        std::max(p.cwiseAbs().maxCoeff(), 0x1.0p-10 * std::abs(scene_magnitude));
-    return 0x1.0p-16 * magnitude;
-}
-
-/// p moved along `normal` (unit, turned to the side the new ray leaves into).
-Point3 offset_ray_origin(const Point3& p, const Normal3& normal, double scene_magnitude) {
-    return p + ray_offset_distance(p, scene_magnitude) * normal;
-}
 
 struct Subject {
     std::string name;
