@@ -242,7 +242,8 @@ TEST(Render, ASceneWithoutLightsIsLitFromTheEyeAndCastsNoShadowRays) {
         EXPECT_GE(value, albedo[c] * 0.995);
     }
     // With one sample, the centre ray is on the axis: exactly the albedo (half-rounded).
-    const Pixel& centre = render(scene, small(21, 21, 1)).image.at(10, 10);
+    // A copy: the RenderResult is a temporary that dies at the end of this statement.
+    const Pixel centre = render(scene, small(21, 21, 1)).image.at(10, 10);
     EXPECT_NEAR(centre.red, albedo.x(), albedo.x() * 0x1.0p-10);
     EXPECT_NEAR(centre.green, albedo.y(), albedo.y() * 0x1.0p-10);
     EXPECT_NEAR(centre.blue, albedo.z(), albedo.z() * 0x1.0p-10);
