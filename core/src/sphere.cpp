@@ -57,7 +57,11 @@ bool Sphere::line_roots(const Ray& ray, double& t0, double& t1) const {
     // sphere of radius 1e-300 has r^2 = 0). Rescale by powers of two, exactly: the sphere to
     // radius in [1, 2) (f s, r s), the direction to its largest component in [1, 2) (d 2^-k).
     // Then f s + tau d 2^-k = s (f + t d) for t = tau 2^(e - k), s = 2^-e.
-    const int direction_exponent = std::ilogb(ray.direction.cwiseAbs().maxCoeff());
+    const double largest = ray.direction.cwiseAbs().maxCoeff();
+    // An invalid direction (zero, NaN, infinite) has no scale; the raw queries must still
+    // return, without the integer overflow ilogb's error value would cause below.
+    if (!(largest > 0.0 && largest < kInfinity) || !is_finite(ray.direction)) return false;
+    const int direction_exponent = std::ilogb(largest);
     const Vector3 direction = ray.direction * std::ldexp(1.0, -direction_exponent);
     if (!quadratic_roots(f * scale_, direction, radius_ * scale_, t0, t1)) return false;
     t0 = std::ldexp(t0, exponent_ - direction_exponent);
