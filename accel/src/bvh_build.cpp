@@ -148,8 +148,14 @@ struct Split {
 
 class Builder {
 public:
-    Builder(std::span<BuildPrimitive> primitives, const BvhConfig& config, BinaryBvh& tree)
-        : primitives_(primitives), config_(config), tree_(tree) {}
+    Builder(std::span<BuildPrimitive> primitives, const BvhConfig& config, int leaf_block,
+            BinaryBvh& tree)
+        : primitives_(primitives), config_(config), leaf_block_(leaf_block), tree_(tree) {}
+
+    /// The number of primitive tests a leaf of `count` primitives costs.
+    std::uint32_t tests(std::uint32_t count) const {
+        return (count + std::uint32_t(leaf_block_) - 1) / std::uint32_t(leaf_block_);
+    }
 
     /// The box and centroid box of all primitives, for the root.
     Range root() const {
@@ -177,7 +183,7 @@ public:
             const double split_cost = config_.traversal_cost + config_.intersection_cost *
                                                                    (a.half_area() + b.half_area()) /
                                                                    range.box.half_area();
-            if (split_cost < 2.0 * config_.intersection_cost || config_.max_leaf_size < 2) {
+            if (split_cost < config_.intersection_cost * tests(2) || config_.max_leaf_size < 2) {
                 left = {range.begin, range.begin + 1, a, Box::empty()};
                 right = {range.begin + 1, range.end, b, Box::empty()};
                 left.centroids.extend(doubled_centroid(pair[0]));
@@ -188,7 +194,7 @@ public:
             const int bin_count = bins_for(count);
             const BinMapping mapping(range.centroids, bin_count);
             const Split best = find_split(range, mapping, bin_count);
-            const double leaf_cost = config_.intersection_cost * count;
+            const double leaf_cost = config_.intersection_cost * tests(count);
             const double split_cost = config_.traversal_cost +
                                       config_.intersection_cost * best.cost / range.box.half_area();
             const bool split_pays = best.axis >= 0 && split_cost < leaf_cost;
@@ -273,13 +279,13 @@ private:
         for (int axis = 0; axis < 3; ++axis) {
             if (mapping.scales[axis] == 0.0f) continue;
             // Sweep from the right, then from the left: the cost of splitting after bin b is
-            // area(left) count(left) + area(right) count(right).
+            // area(left) tests(left) + area(right) tests(right).
             Box right = Box::empty();
             std::uint32_t right_count = 0;
             for (int b = bin_count - 1; b > 0; --b) {
                 right.extend(bins.boxes[axis][b]);
                 right_count += bins.counts[axis][b];
-                right_cost[b] = right_count ? right.half_area() * right_count : -1.0;
+                right_cost[b] = right_count ? right.half_area() * tests(right_count) : -1.0;
             }
             Box left = Box::empty();
             std::uint32_t left_count = 0;
@@ -287,7 +293,7 @@ private:
                 left.extend(bins.boxes[axis][b]);
                 left_count += bins.counts[axis][b];
                 if (left_count == 0 || right_cost[b + 1] < 0.0) continue;
-                const double cost = left.half_area() * left_count + right_cost[b + 1];
+                const double cost = left.half_area() * tests(left_count) + right_cost[b + 1];
                 if (cost < best.cost) best = Split{axis, b, cost};
             }
         }
@@ -366,6 +372,7 @@ private:
 
     std::span<BuildPrimitive> primitives_;
     const BvhConfig& config_;
+    int leaf_block_;
     BinaryBvh& tree_;
     /// Node 0 is the root and node 1 is unused, so sibling pairs start at even indices.
     std::atomic<std::uint32_t> next_node_{2};
@@ -378,14 +385,15 @@ double node_half_area(const BvhNode& node) {
     return Box{Float4::load(lower), Float4::load(upper)}.half_area();
 }
 
-double sah_cost(const BinaryBvh& tree, const BvhConfig& config) {
+double sah_cost(const BinaryBvh& tree, const BvhConfig& config, int leaf_block) {
     auto half_area = [](const BvhNode& node) { return node_half_area(node); };
     double total = 0.0;
     for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
         if (i == 1) continue;
         const BvhNode& node = tree.nodes[i];
+        const std::uint32_t tests = (node.count + leaf_block - 1) / leaf_block;
         total += half_area(node) *
-                 (node.is_leaf() ? config.intersection_cost * node.count : config.traversal_cost);
+                 (node.is_leaf() ? config.intersection_cost * tests : config.traversal_cost);
     }
     const double root_area = half_area(tree.nodes[0]);
     return root_area > 0.0 ? total / root_area : 0.0;
@@ -442,7 +450,7 @@ std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
             node.bounds[2 * axis + 1][slot] = child.upper[axis];
         }
         if (child.is_leaf()) {
-            node.first[slot] = child.count == 1 ? binary.indices[child.offset] : child.offset;
+            node.first[slot] = child.offset;
             node.count[slot] = child.count;
         } else {
             node.count[slot] = Node::kInterior;
@@ -469,20 +477,21 @@ std::vector<WideBvhNode<kWidth>> collapse_to_wide(const BinaryBvh& binary) {
 template std::vector<Bvh4Node> collapse_to_wide<4>(const BinaryBvh&);
 template std::vector<Bvh8Node> collapse_to_wide<8>(const BinaryBvh&);
 
-BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config) {
+BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config,
+                           int leaf_block) {
     BinaryBvh tree;
     if (primitives.empty()) return tree;
     // A binary tree over n primitives has at most n - 1 interior nodes, so 2 n slots hold the
     // root, the unused slot and every sibling pair.
     tree.nodes.resize(2 * primitives.size());
-    Builder builder(primitives, config, tree);
+    Builder builder(primitives, config, leaf_block, tree);
     tree.depth = builder.build(0, builder.root(), 0);
     tree.nodes.resize(primitives.size() == 1 ? 1 : builder.node_count());
     tree.nodes.shrink_to_fit();
     tree.leaves = builder.leaf_count();
     tree.indices.resize(primitives.size());
     for (std::size_t i = 0; i < primitives.size(); ++i) tree.indices[i] = primitives[i].index;
-    tree.sah_cost = sah_cost(tree, config);
+    tree.sah_cost = sah_cost(tree, config, leaf_block);
     return tree;
 }
 
