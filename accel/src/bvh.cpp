@@ -77,6 +77,31 @@ void pad_box(const Aabb& box, detail::BuildPrimitive& primitive) {
     }
 }
 
+/// pad_box for a triangle of float corners, in float: twice the padding, computed with
+/// rounding to nearest, still leaves each bound at least kPrimitivePadding (magnitude + size)
+/// beyond the exact one, because the rounding errors are at most a few 2^-24 of the magnitude,
+/// far below the padding's 2^-18 of it; the padding is at least the smallest normal float, so
+/// tiny coordinates are padded too. Corners that are not all finite take the double path.
+void pad_triangle(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c,
+                  detail::BuildPrimitive& primitive) {
+    const Eigen::Vector3f lower = a.cwiseMin(b).cwiseMin(c);
+    const Eigen::Vector3f upper = a.cwiseMax(b).cwiseMax(c);
+    const float magnitude = std::max(lower.cwiseAbs().maxCoeff(), upper.cwiseAbs().maxCoeff());
+    if (!(magnitude <= std::numeric_limits<float>::max())) {
+        Aabb box;
+        for (const Eigen::Vector3f* corner : {&a, &b, &c}) box.extend(corner->cast<double>());
+        pad_box(box, primitive);
+        return;
+    }
+    constexpr auto kPadding = static_cast<float>(2.0 * Bvh<TriangleSet<float>>::kPrimitivePadding);
+    const float padding = std::max(kPadding * (magnitude + (upper - lower).maxCoeff()),
+                                   std::numeric_limits<float>::min());
+    for (int axis = 0; axis < 3; ++axis) {
+        primitive.lower[axis] = lower[axis] - padding;
+        primitive.upper[axis] = upper[axis] + padding;
+    }
+}
+
 }  // namespace
 
 namespace detail {
@@ -712,7 +737,11 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     auto prepare_range = [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             detail::BuildPrimitive& primitive = primitives[i];
-            pad_box(set.bounds(i), primitive);
+            if constexpr (kBlockSet) {
+                pad_triangle(set.corner(i, 0), set.corner(i, 1), set.corner(i, 2), primitive);
+            } else {
+                pad_box(set.bounds(i), primitive);
+            }
             primitive.index = static_cast<std::uint32_t>(i);
         }
     };
@@ -732,42 +761,10 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     // index array in order, so blocks are handed out in that order too.
     indices_.clear();
     blocks_.clear();
-    if (blocks) {
-        std::vector<std::uint32_t> leaves;
-        for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
-            if (i != 1 && tree.nodes[i].is_leaf()) leaves.push_back(static_cast<std::uint32_t>(i));
-        }
-        std::sort(leaves.begin(), leaves.end(), [&](std::uint32_t a, std::uint32_t b) {
-            return tree.nodes[a].offset < tree.nodes[b].offset;
-        });
-        std::size_t block_count = 0;
-        for (std::uint32_t leaf : leaves)
-            block_count += (tree.nodes[leaf].count + kBlockLanes - 1) / kBlockLanes;
-        blocks_.assign(block_count, BvhTriangleBlock{});
-        std::uint32_t next_block = 0;
-        for (std::uint32_t leaf : leaves) {
-            BvhNode& node = tree.nodes[leaf];
-            for (std::uint32_t k = 0; k < node.count; ++k) {
-                BvhTriangleBlock& block = blocks_[next_block + k / kBlockLanes];
-                const std::uint32_t lane = k % kBlockLanes;
-                const std::uint32_t primitive = tree.indices[node.offset + k];
-                block.primitive[lane] = primitive;
-                if constexpr (kBlockSet) {
-                    for (int corner = 0; corner < 3; ++corner) {
-                        for (int axis = 0; axis < 3; ++axis)
-                            block.corners[corner][axis][lane] = set.corner(primitive, corner)[axis];
-                    }
-                }
-            }
-            for (std::uint32_t lane = node.count % kBlockLanes; lane != 0 && lane < kBlockLanes;
-                 ++lane) {
-                blocks_[next_block + node.count / kBlockLanes].primitive[lane] = kNoIndex;
-            }
-            node.offset = next_block;
-            next_block += (node.count + kBlockLanes - 1) / kBlockLanes;
-        }
-        tree.indices = {};
-    } else {
+    if constexpr (kBlockSet) {
+        if (blocks) fill_blocks(set, tree, config.parallel);
+    }
+    if (!blocks) {
         for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
             BvhNode& node = tree.nodes[i];
             if (i != 1 && node.count == 1) node.offset = tree.indices[node.offset];
@@ -806,6 +803,62 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     stats_.details = details;
     stats_.build_milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+template <class Set>
+void Bvh<Set>::fill_blocks(const Set& set, detail::BinaryBvh& tree, bool parallel) {
+    if (tree.nodes.empty()) return;
+    // The leaves in index order: depth first, left child first.
+    std::vector<std::uint32_t> leaves, pending{0};
+    leaves.reserve(tree.leaves);
+    while (!pending.empty()) {
+        const std::uint32_t index = pending.back();
+        pending.pop_back();
+        const BvhNode& node = tree.nodes[index];
+        if (node.is_leaf()) {
+            leaves.push_back(index);
+        } else {
+            pending.push_back(node.offset + 1);
+            pending.push_back(node.offset);
+        }
+    }
+    std::vector<std::uint32_t> first_block(leaves.size() + 1, 0);
+    for (std::size_t k = 0; k < leaves.size(); ++k) {
+        first_block[k + 1] =
+            first_block[k] + (tree.nodes[leaves[k]].count + kBlockLanes - 1) / kBlockLanes;
+    }
+    // Every lane of every block is written below: lanes past a leaf's count get zeros and
+    // kNoIndex. The storage is left uninitialised until then.
+    blocks_.resize(first_block.back());
+    auto fill = [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            BvhNode& node = tree.nodes[leaves[k]];
+            for (std::uint32_t slot = 0;
+                 slot != (first_block[k + 1] - first_block[k]) * kBlockLanes; ++slot) {
+                BvhTriangleBlock& block = blocks_[first_block[k] + slot / kBlockLanes];
+                const std::uint32_t lane = slot % kBlockLanes;
+                const bool used = slot < node.count;
+                const std::uint32_t primitive = used ? tree.indices[node.offset + slot] : kNoIndex;
+                block.primitive[lane] = primitive;
+                if constexpr (detail::BvhTraversal<Set>::kBlockSet) {
+                    for (int corner = 0; corner < 3; ++corner) {
+                        for (int axis = 0; axis < 3; ++axis) {
+                            block.corners[corner][axis][lane] =
+                                used ? set.corner(primitive, corner)[axis] : 0.0f;
+                        }
+                    }
+                }
+            }
+            node.offset = first_block[k];
+        }
+    };
+    const tbb::blocked_range<std::size_t> all(0, leaves.size(), 1024);
+    if (parallel) {
+        tbb::parallel_for(all, fill);
+    } else {
+        fill(all);
+    }
+    tree.indices = {};
 }
 
 template <class Set>

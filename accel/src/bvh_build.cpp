@@ -1,12 +1,13 @@
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_invoke.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <new>
 
 #include "bvh_simd.h"
 #include "csgrt/accel/bvh_build.h"
@@ -17,10 +18,11 @@ namespace {
 
 constexpr float kInfinityFloat = std::numeric_limits<float>::infinity();
 constexpr int kMaxBins = 256;
-/// Below these sizes a subtree is built, or a node binned, on one thread: smaller tasks cost
-/// more to schedule than they save.
+/// Below this size a subtree is built on one thread: smaller tasks cost more to schedule than
+/// they save.
 constexpr std::uint32_t kParallelSubtree = 4096;
-constexpr std::uint32_t kParallelBinning = 1u << 16;
+/// Nodes larger than this find their split on a sample of their primitives.
+constexpr std::uint32_t kSampledBinning = 1u << 14;
 
 /// A float box in two SIMD registers (the fourth lane is unused).
 struct Box {
@@ -60,6 +62,12 @@ struct Box {
         const double x = double(h[0]) - l[0], y = double(h[1]) - l[1], z = double(h[2]) - l[2];
         return x * y + y * z + z * x;
     }
+    /// Half the surface area of the box scaled by `scale` (all lanes equal), in float; the box
+    /// must not be empty.
+    float scaled_half_area(Float4 scale) const {
+        const Float4 extent = (upper - lower) * scale;
+        return (extent * extent.rotate()).sum3();
+    }
 };
 
 /// Twice the centre of a primitive's box: binning only needs it up to scale.
@@ -78,7 +86,7 @@ struct Range {
 /// binning and when partitioning, so both agree on every primitive.
 struct BinMapping {
     Float4 origin, scale, last;
-    float scales[4];
+    float origins[4], scales[4];
 
     BinMapping(const Box& centroids, int bin_count) {
         float l[4], h[4];
@@ -94,6 +102,7 @@ struct BinMapping {
         }
         l[3] = 0.0f;
         scales[3] = 0.0f;
+        std::copy_n(l, 4, origins);
         origin = Float4::load(l);
         scale = Float4::load(scales);
         last = Float4::broadcast(float(bin_count - 1));
@@ -104,6 +113,14 @@ struct BinMapping {
         // last bin, so the truncation always sees a value in [0, bins - 1].
         const Float4 position = (doubled_centroid(p) - origin) * scale;
         min(max(position, Float4::broadcast(0.0f)), last).truncate(out);
+    }
+    /// Whether the primitive's bin on `axis` is at most `bin`: bins() computes the position
+    /// with the same float operations and truncates it after clamping it to [0, bins - 1],
+    /// which gives a bin > `bin` exactly when the position is >= bin + 1 (a NaN position
+    /// goes to bin 0).
+    bool bin_at_most(const BuildPrimitive& p, int axis, int bin) const {
+        const float position = (p.lower[axis] + p.upper[axis] - origins[axis]) * scales[axis];
+        return !(position >= float(bin + 1));
     }
 };
 
@@ -128,33 +145,30 @@ struct Bins {
             ++counts[axis][bin[axis]];
         }
     }
-    void join(const Bins& other) {
-        for (int axis = 0; axis < 3; ++axis) {
-            for (int b = 0; b < bin_count; ++b) {
-                boxes[axis][b].extend(other.boxes[axis][b]);
-                counts[axis][b] += other.counts[axis][b];
-            }
-        }
-    }
 };
 
 struct Split {
     int axis = -1;
     /// Bins 0 .. bin go left.
     int bin = 0;
-    /// Sum over both sides of half area times primitive count.
-    double cost = std::numeric_limits<double>::infinity();
+    /// Sum over both sides of half area times primitive tests (relative to the node's half
+    /// area once find_split returns it).
+    float cost = std::numeric_limits<float>::infinity();
 };
 
 class Builder {
 public:
     Builder(std::span<BuildPrimitive> primitives, const BvhConfig& config, int leaf_block,
-            BinaryBvh& tree)
-        : primitives_(primitives), config_(config), leaf_block_(leaf_block), tree_(tree) {}
+            BvhNode* nodes)
+        : primitives_(primitives),
+          config_(config),
+          leaf_block_shift_(std::countr_zero(unsigned(leaf_block))),
+          nodes_(nodes) {}
 
-    /// The number of primitive tests a leaf of `count` primitives costs.
+    /// The number of primitive tests a leaf of `count` primitives costs (a shift, not a
+    /// division: the sweep calls this for every bin).
     std::uint32_t tests(std::uint32_t count) const {
-        return (count + std::uint32_t(leaf_block_) - 1) / std::uint32_t(leaf_block_);
+        return (count + (1u << leaf_block_shift_) - 1) >> leaf_block_shift_;
     }
 
     /// The box and centroid box of all primitives, for the root.
@@ -170,7 +184,7 @@ public:
     /// Builds the subtree of `range` into node `node`; returns its depth.
     int build(std::uint32_t node, const Range& range, int depth) {
         const std::uint32_t count = range.end - range.begin;
-        BvhNode& target = tree_.nodes[node];
+        BvhNode& target = nodes_[node];
         range.box.store(target.lower, target.upper);
 
         Range left, right;
@@ -195,8 +209,8 @@ public:
             const BinMapping mapping(range.centroids, bin_count);
             const Split best = find_split(range, mapping, bin_count);
             const double leaf_cost = config_.intersection_cost * tests(count);
-            const double split_cost = config_.traversal_cost +
-                                      config_.intersection_cost * best.cost / range.box.half_area();
+            const double split_cost =
+                config_.traversal_cost + config_.intersection_cost * best.cost;
             const bool split_pays = best.axis >= 0 && split_cost < leaf_cost;
             if (best.axis >= 0 && (split_pays || count > std::uint32_t(config_.max_leaf_size))) {
                 partition(range, mapping, best, left, right);
@@ -248,34 +262,32 @@ private:
 
     /// The cheapest binned split over all three axes (axis -1 when the centroids coincide).
     Split find_split(const Range& range, const BinMapping& mapping, int bin_count) const {
+        // Nodes of more than kSampledBinning primitives bin an evenly strided sample of
+        // kSampledBinning / 2 to kSampledBinning of them: the bins' counts and boxes are then
+        // estimates, which pick the split plane about as well, while binning costs a fraction
+        // (the partition still moves and bounds every primitive). The approximation is that of
+        // Hunt, Mark and Stoll, "Fast kd-tree Construction with an Adaptive Error-Bounded
+        // Heuristic", 2006.
         Bins bins(bin_count);
-        if (!config_.parallel || range.end - range.begin < kParallelBinning) {
-            for (std::uint32_t i = range.begin; i != range.end; ++i)
-                bins.add(mapping, primitives_[i]);
-        } else {
-            // Each task bins a chunk into its own bins; the results are summed.
-            struct Body {
-                const Builder& builder;
-                const BinMapping& mapping;
-                Bins bins;
-                Body(const Builder& b, const BinMapping& m, int n)
-                    : builder(b), mapping(m), bins(n) {}
-                Body(Body& other, tbb::split)
-                    : builder(other.builder), mapping(other.mapping), bins(other.bins.bin_count) {}
-                void operator()(const tbb::blocked_range<std::uint32_t>& chunk) {
-                    for (std::uint32_t i = chunk.begin(); i != chunk.end(); ++i)
-                        bins.add(mapping, builder.primitives_[i]);
-                }
-                void join(const Body& other) { bins.join(other.bins); }
-            };
-            Body body(*this, mapping, bin_count);
-            tbb::parallel_reduce(
-                tbb::blocked_range<std::uint32_t>(range.begin, range.end, 1u << 14), body);
-            bins = body.bins;
-        }
+        const std::uint32_t count = range.end - range.begin;
+        const std::uint32_t stride = count > kSampledBinning ? count / (kSampledBinning / 2) : 1u;
+        for (std::uint32_t i = range.begin; i < range.end; i += stride)
+            bins.add(mapping, primitives_[i]);
+
+        // The sweep computes areas in float, on extents scaled by a power of two that brings
+        // the node's largest extent just below 1: no product overflows, and scaling by a power
+        // of two loses no precision.
+        float lower[4], upper[4];
+        range.box.lower.store(lower);
+        range.box.upper.store(upper);
+        const float largest =
+            std::max({upper[0] - lower[0], upper[1] - lower[1], upper[2] - lower[2]});
+        const int exponent = largest > 0.0f && std::isfinite(largest) ? std::ilogb(largest) + 1 : 0;
+        const Float4 scale = Float4::broadcast(std::ldexp(1.0f, std::clamp(-exponent, -126, 126)));
+        const float node_area = range.box.scaled_half_area(scale);
 
         Split best;
-        double right_cost[kMaxBins];
+        float right_cost[kMaxBins];
         for (int axis = 0; axis < 3; ++axis) {
             if (mapping.scales[axis] == 0.0f) continue;
             // Sweep from the right, then from the left: the cost of splitting after bin b is
@@ -285,18 +297,22 @@ private:
             for (int b = bin_count - 1; b > 0; --b) {
                 right.extend(bins.boxes[axis][b]);
                 right_count += bins.counts[axis][b];
-                right_cost[b] = right_count ? right.half_area() * tests(right_count) : -1.0;
+                right_cost[b] =
+                    right_count ? right.scaled_half_area(scale) * float(tests(right_count)) : -1.0f;
             }
             Box left = Box::empty();
             std::uint32_t left_count = 0;
             for (int b = 0; b < bin_count - 1; ++b) {
                 left.extend(bins.boxes[axis][b]);
                 left_count += bins.counts[axis][b];
-                if (left_count == 0 || right_cost[b + 1] < 0.0) continue;
-                const double cost = left.half_area() * tests(left_count) + right_cost[b + 1];
+                if (left_count == 0 || right_cost[b + 1] < 0.0f) continue;
+                const float cost =
+                    left.scaled_half_area(scale) * float(tests(left_count)) + right_cost[b + 1];
                 if (cost < best.cost) best = Split{axis, b, cost};
             }
         }
+        // Relative to the node's area, as the SAH wants it.
+        if (best.axis >= 0) best.cost = node_area > 0.0f ? best.cost / node_area : 0.0f;
         return best;
     }
 
@@ -305,9 +321,7 @@ private:
     void partition(const Range& range, const BinMapping& mapping, const Split& split, Range& left,
                    Range& right) {
         auto goes_left = [&](const BuildPrimitive& p) {
-            alignas(16) int bin[4];
-            mapping.bins(p, bin);
-            return bin[split.axis] <= split.bin;
+            return mapping.bin_at_most(p, split.axis, split.bin);
         };
         left = {range.begin, range.begin, Box::empty(), Box::empty()};
         right = {range.end, range.end, Box::empty(), Box::empty()};
@@ -372,8 +386,8 @@ private:
 
     std::span<BuildPrimitive> primitives_;
     const BvhConfig& config_;
-    int leaf_block_;
-    BinaryBvh& tree_;
+    int leaf_block_shift_;
+    BvhNode* nodes_;
     /// Node 0 is the root and node 1 is unused, so sibling pairs start at even indices.
     std::atomic<std::uint32_t> next_node_{2};
     std::atomic<std::size_t> leaves_{0};
@@ -482,12 +496,18 @@ BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig
     BinaryBvh tree;
     if (primitives.empty()) return tree;
     // A binary tree over n primitives has at most n - 1 interior nodes, so 2 n slots hold the
-    // root, the unused slot and every sibling pair.
-    tree.nodes.resize(2 * primitives.size());
-    Builder builder(primitives, config, leaf_block, tree);
+    // root, the unused slot and every sibling pair. They are left uninitialised: a tree has
+    // about 2 n / (primitives per leaf) nodes, and only the pages written are ever touched.
+    struct Free {
+        void operator()(BvhNode* p) const { ::operator delete(p, std::align_val_t(64)); }
+    };
+    const std::unique_ptr<BvhNode, Free> nodes(static_cast<BvhNode*>(
+        ::operator new(2 * primitives.size() * sizeof(BvhNode), std::align_val_t(64))));
+    nodes.get()[1] = BvhNode{};
+    Builder builder(primitives, config, leaf_block, nodes.get());
     tree.depth = builder.build(0, builder.root(), 0);
-    tree.nodes.resize(primitives.size() == 1 ? 1 : builder.node_count());
-    tree.nodes.shrink_to_fit();
+    tree.nodes.assign(nodes.get(),
+                      nodes.get() + (primitives.size() == 1 ? 1 : builder.node_count()));
     tree.leaves = builder.leaf_count();
     tree.indices.resize(primitives.size());
     for (std::size_t i = 0; i < primitives.size(); ++i) tree.indices[i] = primitives[i].index;

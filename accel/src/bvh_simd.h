@@ -76,6 +76,15 @@ struct Float4 {
     unsigned mask() const {
         return static_cast<unsigned>(_mm_movemask_ps(v));
     }
+    /// Lanes 1, 2, 0, 3 (x, y, z -> y, z, x).
+    Float4 rotate() const {
+        return {_mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 0, 2, 1))};
+    }
+    /// Lane 0 + lane 1 + lane 2, added in that order.
+    float sum3() const {
+        const __m128 sum = _mm_add_ss(_mm_add_ss(v, _mm_shuffle_ps(v, v, 1)), _mm_movehl_ps(v, v));
+        return _mm_cvtss_f32(sum);
+    }
     /// Truncates each lane to an int (lanes must be in int range).
     void truncate(int* out) const {
         _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_cvttps_epi32(v));
@@ -147,6 +156,12 @@ struct Float4 {
     }
     friend Float4 and_not(Float4 a, Float4 b) {
         return bitwise(a, b, [](std::uint32_t x, std::uint32_t y) { return ~x & y; });
+    }
+    Float4 rotate() const {
+        return {{v[1], v[2], v[0], v[3]}};
+    }
+    float sum3() const {
+        return v[0] + v[1] + v[2];
     }
     unsigned mask() const {
         unsigned m = 0;

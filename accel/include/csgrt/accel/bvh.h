@@ -78,6 +78,10 @@ public:
 private:
     friend struct detail::BvhTraversal<Set>;
 
+    /// Copies the triangles of each leaf of `tree` into blocks_, in leaf order, and points
+    /// the leaves at their first block (TriangleSet<float> only).
+    void fill_blocks(const Set& set, detail::BinaryBvh& tree, bool parallel);
+
     const Set* set_ = nullptr;
     BvhConfig config_;
     bool use_avx2_ = false;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <new>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace csgrt {
@@ -98,6 +99,16 @@ struct AlignedAllocator {
         return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(kAlignment)));
     }
     void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(kAlignment)); }
+    /// Elements made without a value are default-initialised (left as they are, for the
+    /// node and block types), so that resizing a large array does not first zero it.
+    template <class U>
+    void construct(U* p) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
     template <class U>
     bool operator==(const AlignedAllocator<U, kAlignment>&) const {
         return true;
@@ -130,10 +141,10 @@ struct BinaryBvh {
 
 /// Builds a binary BVH over `primitives` (reordered in place) with the binned surface-area
 /// heuristic of Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies", 2007.
-/// A leaf of n primitives costs ceil(n / leaf_block) primitive tests (leaf_block 4: leaves
-/// tested four primitives at a time). Beyond a depth of kMaxSahDepth nodes are split at the
-/// object median instead, so the depth stays under kMaxDepth whatever the input. A leaf's
-/// `offset` is the position of its first primitive in `primitives` and `indices`; leaves
+/// A leaf of n primitives costs ceil(n / leaf_block) primitive tests (leaf_block, a power of
+/// two: 4 for leaves tested four primitives at a time). Beyond a depth of kMaxSahDepth nodes are
+/// split at the object median instead, so the depth stays under kMaxDepth whatever the input. A
+/// leaf's `offset` is the position of its first primitive in `primitives` and `indices`; leaves
 /// cover those positions in order, left subtrees first. The config is assumed valid.
 BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config,
                            int leaf_block = 1);
