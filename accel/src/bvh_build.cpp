@@ -189,7 +189,11 @@ public:
 
         Range left, right;
         bool split = false;
-        if (count == 2 && depth < kMaxSahDepth && !coincident(range.centroids)) {
+        if (tests(count) == 1 && count <= std::uint32_t(config_.max_leaf_size) &&
+            config_.traversal_cost >= config_.intersection_cost) {
+            // A leaf of one test costs intersection_cost; any split costs at least
+            // traversal_cost, which is no less, so the SAH keeps the leaf: no need to bin.
+        } else if (count == 2 && depth < kMaxSahDepth && !coincident(range.centroids)) {
             // Two primitives allow one split, whose SAH cost needs no bins: this is the most
             // common node near the leaves.
             const BuildPrimitive* pair = primitives_.data() + range.begin;
