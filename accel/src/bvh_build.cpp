@@ -1,4 +1,6 @@
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -171,14 +173,27 @@ public:
         return (count + (1u << leaf_block_shift_) - 1) >> leaf_block_shift_;
     }
 
-    /// The box and centroid box of all primitives, for the root.
+    /// The box and centroid box of all primitives, for the root (in parallel chunks when the
+    /// config says so: min and max give the same boxes in any order).
     Range root() const {
-        Range range{0, static_cast<std::uint32_t>(primitives_.size()), Box::empty(), Box::empty()};
-        for (const BuildPrimitive& p : primitives_) {
-            range.box.extend(Box::of(p));
-            range.centroids.extend(doubled_centroid(p));
-        }
-        return range;
+        using Chunk = tbb::blocked_range<std::size_t>;
+        auto bound = [&](const Chunk& chunk, Range range) {
+            for (std::size_t i = chunk.begin(); i != chunk.end(); ++i) {
+                range.box.extend(Box::of(primitives_[i]));
+                range.centroids.extend(doubled_centroid(primitives_[i]));
+            }
+            return range;
+        };
+        const Range empty{0, static_cast<std::uint32_t>(primitives_.size()), Box::empty(),
+                          Box::empty()};
+        const Chunk all(0, primitives_.size(), 1u << 14);
+        if (!config_.parallel) return bound(all, empty);
+        return tbb::parallel_reduce(all, empty, bound, [](Range a, const Range& b) {
+            a.box.extend(b.box);
+            a.centroids.extend(b.centroids.lower);
+            a.centroids.extend(b.centroids.upper);
+            return a;
+        });
     }
 
     /// Builds the subtree of `range` into node `node`; returns its depth.

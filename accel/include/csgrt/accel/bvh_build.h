@@ -124,7 +124,8 @@ struct alignas(16) BuildPrimitive {
     float lower[3];
     std::uint32_t index;
     float upper[3];
-    float unused = 0.0f;
+    /// Zero (the fourth lane of the box's upper corner).
+    float unused;
 };
 
 /// A binary BVH as built: nodes (see BvhNode), the primitive indices in leaf order, and
