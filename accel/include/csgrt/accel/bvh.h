@@ -15,10 +15,10 @@ struct BvhTraversal;
 
 /// A bounding volume hierarchy over a primitive set, built top down with the binned SAH
 /// (Wald 2007, see bvh_build.h) and, by default, collapsed into 8-wide nodes whose boxes are
-/// tested four at a time with SSE. Each primitive is referenced exactly once, by index, in
-/// leaf order (a leaf of one primitive names it directly).
+/// tested eight at a time with AVX2 where the CPU has it, else four at a time with SSE. Each
+/// primitive is referenced exactly once, in leaf order.
 ///
-/// Boxes are float, rounded outward from the set's double boxes after padding them by
+/// Boxes are float, rounded outward from the primitives' boxes after padding them by at least
 /// kPrimitivePadding of their size and magnitude, and the float slab test widens each
 /// [t_enter, t_exit] by the relative kSlabSlack (Ize, "Robust BVH Ray Traversal", JCGT 2013,
 /// does this with 2 gamma(3) for the box test alone). Together they cover the rounding of the

@@ -22,8 +22,8 @@ struct BvhConfig {
     /// SAH cost of one primitive test. Must be > 0.
     double intersection_cost = 1.0;
     /// 8 or 4: the binary tree is collapsed into 8- or 4-wide nodes whose boxes are tested
-    /// four at a time (8, the default, measured about 10% faster than 4 on the armadillo);
-    /// 2: the binary tree is traversed as built.
+    /// four (SSE) or eight (AVX2, see `avx2`) at a time (8, the default, measured about 10% faster
+    /// than 4 on the armadillo); 2: the binary tree is traversed as built.
     int width = 8;
     /// Build large subtrees on several threads (oneTBB); the tree is the same either way.
     bool parallel = true;
