@@ -206,6 +206,13 @@ int main(int argc, char** argv) {
     context.mode = settings.mode;
     context.threads = settings.threads;
     context.embree = csgrt::bench::embree_version();
+    context.settings = "camera " + std::to_string(settings.sizes.camera_width) + "x" +
+                       std::to_string(settings.sizes.camera_width) + ", " +
+                       std::to_string(settings.sizes.incoherent) +
+                       " incoherent rays, shadow "
+                       "rays from the camera hits, brute force " +
+                       std::to_string(static_cast<long long>(settings.brute_budget)) +
+                       " triangle tests a pass";
     benchmark::AddCustomContext("csgrt_mode", settings.mode);
     benchmark::AddCustomContext("csgrt_commit", options.commit);
     benchmark::AddCustomContext("csgrt_embree", context.embree);
