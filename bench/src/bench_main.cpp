@@ -196,6 +196,10 @@ int main(int argc, char** argv) {
     std::string min_time = "--benchmark_min_time=";
     min_time += settings.mode == "quick" ? "0.05" : settings.mode == "full" ? "0.5" : "0.2";
     if (!has_flag(argc, argv, "--benchmark_min_time")) arguments.push_back(min_time.data());
+    // Initialize removes the flags it knows, so what the output format is must be read first.
+    const bool format_given = has_flag(argc, argv, "--benchmark_format");
+    const bool machine_readable = has_flag(argc, argv, "--benchmark_format=json") ||
+                                  has_flag(argc, argv, "--benchmark_format=csv");
     int count = static_cast<int>(arguments.size());
     arguments.push_back(nullptr);
     benchmark::Initialize(&count, arguments.data());
@@ -220,20 +224,24 @@ int main(int argc, char** argv) {
     csgrt::bench::Workloads workloads(settings.sizes);
     register_all(workloads, settings);
 
-    csgrt::bench::CollectingReporter reporter(benchmark::CreateDefaultDisplayReporter());
+    const bool compact = settings.mode == "quick" && !format_given;
+    csgrt::bench::CollectingReporter reporter(compact ? csgrt::bench::make_compact_reporter()
+                                                      : benchmark::CreateDefaultDisplayReporter());
+    if (compact) {
+        std::printf("csgrt_bench --quick on %s (%d hardware threads), load average %s\n",
+                    context.machine.c_str(), context.cores, context.load_before.c_str());
+    }
     benchmark::RunSpecifiedBenchmarks(&reporter);
     benchmark::Shutdown();
     context.load_after = csgrt::bench::load_average();
 
     // The summary goes where it does not spoil machine-readable output.
-    const bool console = !has_flag(count, arguments.data(), "--benchmark_format=json") &&
-                         !has_flag(count, arguments.data(), "--benchmark_format=csv");
-    std::FILE* out = console ? stdout : stderr;
+    std::FILE* out = machine_readable ? stderr : stdout;
     const auto& sizes = settings.sizes;
     std::fprintf(out,
-                 "\ncsgrt_bench summary: armadillo, camera rays (%dx%d) and %zu incoherent rays, "
-                 "1 thread (CPU time); brute force on a subset; peers CGAL 5.5 AABB tree and "
-                 "%s, measured in this run.\n",
+                 "\ncsgrt_bench summary: armadillo, %dx%d camera rays and %zu incoherent rays, "
+                 "1 thread (CPU time),\nbrute force on an evenly spread subset; peers measured "
+                 "in this run: CGAL 5.5 AABB tree, %s.\n",
                  sizes.camera_width, sizes.camera_width, sizes.incoherent, context.embree.c_str());
     std::fprintf(out, "%s", csgrt::bench::summary_table(reporter.results(), "armadillo").c_str());
     std::fprintf(out, "load average before %s, after %s\n", context.load_before.c_str(),

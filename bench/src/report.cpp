@@ -75,6 +75,39 @@ void CollectingReporter::Finalize() {
     display_->Finalize();
 }
 
+namespace {
+
+class CompactReporter final : public benchmark::BenchmarkReporter {
+public:
+    bool ReportContext(const Context&) override { return true; }
+    void ReportRuns(const std::vector<Run>& runs) override {
+        for (const Run& run : runs) {
+            if (run.run_type == Run::RT_Aggregate) continue;
+            std::ostream& out = GetOutputStream();
+            char name[96];
+            std::snprintf(name, sizeof name, "  %-48s", run.run_name.function_name.c_str());
+            out << name;
+            if (run.error_occurred) {
+                out << ": " << run.error_message << "\n";
+                continue;
+            }
+            const auto rays = run.counters.find("rays");
+            if (rays != run.counters.end()) {
+                char text[64];
+                std::snprintf(text, sizeof text, " %10.3g Mrays/s", rays->second.value * 1e-6);
+                out << text;
+            }
+            out << "\n" << std::flush;
+        }
+    }
+};
+
+}  // namespace
+
+benchmark::BenchmarkReporter* make_compact_reporter() {
+    return new CompactReporter();
+}
+
 std::string load_average() {
     std::ifstream file("/proc/loadavg");
     double one = 0.0, five = 0.0, fifteen = 0.0;

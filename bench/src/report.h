@@ -62,6 +62,10 @@ private:
     std::vector<Result> results_;
 };
 
+/// A one-line-per-benchmark display for --quick: the name and its Mrays/s (Google
+/// Benchmark's own table, with every counter, is what the other modes show).
+benchmark::BenchmarkReporter* make_compact_reporter();
+
 /// Where and how the run happened, for the report's header.
 struct RunContext {
     std::string date;
