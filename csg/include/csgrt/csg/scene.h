@@ -59,7 +59,8 @@ class Scene {
 public:
     Scene();
 
-    /// Material 0 always exists: a neutral grey. Returns the new material's index.
+    /// Material 0 always exists: a neutral grey named "default". Returns the new material's
+    /// index. Throws InvalidParameter for an albedo outside [0, 1].
     std::uint32_t add_material(Material material);
     /// Returns the object's index (its object id in hits and in the renderer's id channel).
     /// Throws InvalidParameter for a null shape or an unknown material.
@@ -68,7 +69,10 @@ public:
     void add_light(Light light);
     void set_camera(Camera camera);
 
-    /// Builds everything queries need. Throws InvalidParameter for an unknown structure name.
+    /// Builds everything queries need: validates the camera, computes the bounds, and builds
+    /// the structure over the bounded objects ("auto": choose_accelerator in csg/compound.h,
+    /// documented in docs/scene.md). Throws InvalidParameter for an invalid camera or an
+    /// unknown structure name; the scene is then left uncommitted.
     void commit(const SceneConfig& config = {});
     bool is_committed() const { return committed_; }
 
