@@ -21,13 +21,12 @@ struct Settings {
     int threads = 1;
     /// The repository's data/ folder (meshes, generated meshes, scenes).
     std::filesystem::path data;
-    /// The folder of the POV-Ray versions of the CSG scenes (bench/povray).
-    std::filesystem::path povray;
     /// Image width and height of the accuracy section's camera rays.
     int accuracy_width = 256;
     /// Rays each accuracy variant is timed and judged on.
     std::size_t accuracy_rays = 4096;
-    bool run_povray = true;
+    /// Width and height of a CSG scene's frame.
+    int csg_width = 512;
 };
 
 /// The meshes of the run by name, loaded on first use. Before a mesh is handed out, other
@@ -62,8 +61,12 @@ void register_build(Workloads& workloads, const std::string& mesh, const Variant
 /// accuracy/<group>/<variant>: run time against error (bench/src/accuracy.cpp).
 void register_accuracy_benchmarks(Workloads& workloads, const Settings& settings);
 
-/// csg/<scene>/<hierarchy|flat> and povray/<scene> (bench/src/csg_scenes.cpp); registers
-/// nothing when the scene file loader is not available.
+/// The scene files of `data`/scenes, sorted.
+std::vector<std::filesystem::path> csg_scene_files(const std::filesystem::path& data);
+
+/// csg/<scene>/<structure>/threads:<n>: a frame of each scene file with shadows, its objects
+/// under each registered structure ("brute": no hierarchical bounding boxes), with the object
+/// and box tests per camera ray (bench/src/csg_scenes.cpp).
 void register_csg_benchmarks(const Settings& settings);
 
 }  // namespace csgrt::bench

@@ -52,7 +52,9 @@ void CollectingReporter::ReportRuns(const std::vector<Run>& runs) {
         result.name = run.run_name.function_name;
         const auto info = registry().find(result.name);
         if (info != registry().end()) result.info = info->second;
-        result.real_time = run.run_name.time_type.find("real_time") != std::string::npos;
+        // Manual time (the CSG frames) is kept where real time is.
+        result.real_time = run.run_name.time_type.find("real_time") != std::string::npos ||
+                           run.run_name.time_type.find("manual_time") != std::string::npos;
         result.iterations = run.iterations;
         const double iterations = std::max<double>(1.0, static_cast<double>(run.iterations));
         const double accumulated =
@@ -92,7 +94,11 @@ public:
                 continue;
             }
             const auto rays = run.counters.find("rays");
-            if (rays != run.counters.end()) {
+            if (run.run_name.function_name.rfind("csg/", 0) == 0) {
+                char text[64];
+                std::snprintf(text, sizeof text, " %10.3g ms/frame", run.GetAdjustedRealTime());
+                out << text;
+            } else if (rays != run.counters.end()) {
                 char text[64];
                 std::snprintf(text, sizeof text, " %10.3g Mrays/s", rays->second.value * 1e-6);
                 out << text;
@@ -231,6 +237,37 @@ std::string summary_table(const std::vector<Result>& results, const std::string&
                 << pad(format_ratio(rate / trace_rate(results, mesh, "embree", set, 1)), 9);
         }
         out << "\n";
+    }
+    return out.str();
+}
+
+std::string csg_summary_table(const std::vector<Result>& results, int threads) {
+    std::ostringstream out;
+    for (const Result& result : results) {
+        const BenchmarkInfo& info = result.info;
+        if (info.section != "csg" || info.threads != threads) continue;
+        if (out.tellp() == 0) {
+            out << pad("scene", 16) << pad("structure", 11) << pad("objects", 9)
+                << pad("ms/frame", 10) << pad("x brute", 9) << pad("objects/ray", 13)
+                << pad("boxes/ray", 11) << "\n";
+        }
+        if (result.failed) {
+            out << pad(info.subject, 16) << pad(info.variant, 11) << "  failed: " << result.message
+                << "\n";
+            continue;
+        }
+        const Result* brute = find_result(results, "csg", info.subject, "brute", "frame", 1);
+        const double flat =
+            brute != nullptr ? brute->seconds : std::numeric_limits<double>::quiet_NaN();
+        std::string frame = format_number(result.seconds * 1e3);
+        if (result.counter("rendered_width") != result.counter("frame_width")) {
+            frame += "*";
+        }
+        out << pad(info.subject, 16) << pad(info.variant, 11)
+            << pad(std::to_string(std::llround(result.counter("objects"))), 9) << pad(frame, 10)
+            << pad(format_ratio(flat / result.seconds), 9)
+            << pad(format_number(result.counter("objects_per_ray")), 13)
+            << pad(format_number(result.counter("boxes_per_ray")), 11) << "\n";
     }
     return out.str();
 }
@@ -663,6 +700,52 @@ void accuracy_section(std::ostream& out, Json& json, const std::vector<Result>& 
     }
 }
 
+void csg_section(std::ostream& out, Json& json, const std::vector<Result>& results, int threads) {
+    Table table({"scene", "structure", "threads", "objects", "ms/frame", "Mrays/s", "x brute",
+                 "x 1 thread", "objects/ray", "boxes/ray", "nodes/ray", "rendered"});
+    for (const Result& result : results) {
+        const BenchmarkInfo& info = result.info;
+        if (info.section != "csg" || result.failed) continue;
+        const Result* brute = find_result(results, "csg", info.subject, "brute", "frame", 1);
+        const Result* one = find_result(results, "csg", info.subject, info.variant, "frame", 1);
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        const double over_brute =
+            info.threads == 1 && brute != nullptr ? brute->seconds / result.seconds : nan;
+        const double over_one =
+            info.threads > 1 && one != nullptr ? one->seconds / result.seconds : nan;
+        const double rendered = result.counter("rendered_width");
+        table.add({info.subject, info.variant, std::to_string(info.threads),
+                   std::to_string(std::llround(result.counter("objects"))),
+                   format_number(result.seconds * 1e3),
+                   format_number(result.counter("rays") * 1e-6), format_ratio(over_brute),
+                   format_ratio(over_one), format_number(result.counter("objects_per_ray")),
+                   format_number(result.counter("boxes_per_ray")),
+                   format_number(result.counter("nodes_per_ray")),
+                   std::to_string(std::llround(rendered)) + "x" +
+                       std::to_string(std::llround(rendered))});
+        json["csg"].push_back({{"scene", info.subject},
+                               {"structure", info.variant},
+                               {"threads", info.threads},
+                               {"frame_ms", result.seconds * 1e3},
+                               {"objects_per_ray", result.counter("objects_per_ray")},
+                               {"boxes_per_ray", result.counter("boxes_per_ray")},
+                               {"rendered_width", rendered}});
+    }
+    if (table.empty()) return;
+    out << "## CSG scenes\n\nEach scene of data/scenes/ rendered by the library's renderer "
+           "(one sample a pixel, Lambert, one hard shadow ray a light), its top-level objects "
+           "under each structure: brute is the scene without hierarchical bounding boxes (every "
+           "object on every ray), the others a hierarchy of boxes or cells over them. ms/frame "
+           "is for the full square frame (one thread: process CPU time; "
+        << threads
+        << " threads: wall time); where brute force would exceed the run's budget of object "
+           "tests it renders a smaller frame of the same view (\"rendered\") and its time is "
+           "scaled by the ratio of pixels. objects/ray, boxes/ray, nodes/ray: the top-level "
+           "structure's work on a sample of camera rays (Scene::intersect_counted); the work "
+           "inside a CSG object or a mesh is not counted there.\n\n"
+        << table.markdown() << "\n";
+}
+
 }  // namespace
 
 void write_report(const std::filesystem::path& directory, const std::vector<Result>& results,
@@ -692,6 +775,7 @@ void write_report(const std::filesystem::path& directory, const std::vector<Resu
     threads_section(out, results, context.threads);
     build_section(out, results, context.threads);
     scaling_section(out, json, results);
+    csg_section(out, json, results, context.threads);
     targets_section(out, json, results, context.threads);
     accuracy_section(out, json, results);
     std::ofstream(directory / "report.md") << out.str();

@@ -15,7 +15,7 @@ namespace csgrt::bench {
 /// What a registered benchmark measures, recorded when it is registered so the report reads
 /// results by meaning rather than by parsing names.
 struct BenchmarkInfo {
-    /// "trace", "build", "accuracy", "csg" or "povray".
+    /// "trace", "build", "accuracy" or "csg".
     std::string section;
     /// The mesh or scene.
     std::string subject;
@@ -89,6 +89,11 @@ std::string load_average();
 /// incoherent rays, one thread: Mrays/s and the speedups over brute force, CGAL and Embree
 /// measured in the same run.
 std::string summary_table(const std::vector<Result>& results, const std::string& mesh);
+
+/// The CSG scenes' frames at `threads` threads: ms per frame under each structure, the speedup
+/// over brute force (no hierarchical bounding boxes), objects and boxes tested per camera ray;
+/// a * marks a frame timed at a smaller size and scaled. Empty when no scene ran.
+std::string csg_summary_table(const std::vector<Result>& results, int threads);
 
 /// Writes report.md and report.json (the tables the plots are drawn from) into `directory`.
 void write_report(const std::filesystem::path& directory, const std::vector<Result>& results,
