@@ -35,6 +35,9 @@ struct Result {
     std::string name;
     BenchmarkInfo info;
     double seconds = 0.0;
+    /// Wall time of one iteration whatever was measured, so thread scaling compares wall time
+    /// with wall time (a loaded machine slows both alike).
+    double wall_seconds = 0.0;
     bool real_time = false;
     std::int64_t iterations = 0;
     std::map<std::string, double> counters;
