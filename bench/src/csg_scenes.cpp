@@ -88,11 +88,11 @@ void register_scene(const std::shared_ptr<SceneCache>& cache, const Settings& se
                 const double cpu_start = process_cpu_seconds();
                 const auto wall_start = std::chrono::steady_clock::now();
                 const RenderResult result = render(scene, render_settings);
-                const double seconds = threads > 1
-                                           ? std::chrono::duration<double>(
-                                                 std::chrono::steady_clock::now() - wall_start)
-                                                 .count()
-                                           : process_cpu_seconds() - cpu_start;
+                const double cpu = process_cpu_seconds() - cpu_start;
+                wall_seconds =
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start)
+                        .count();
+                const double seconds = threads > 1 ? wall_seconds : cpu;
                 stats = result.stats;
                 state.SetIterationTime(seconds * plan.scale);
             }
