@@ -1,0 +1,265 @@
+#include "csgrt/accel/regular_grid.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "csgrt/accel/shape_set.h"
+#include "csgrt/accel/triangle_set.h"
+#include "csgrt/core/error.h"
+#include "grid_common.h"
+
+namespace csgrt {
+
+namespace detail {
+
+int GridGeometry::cell_coordinate(double p, int axis) const {
+    const double f = (p - bounds.lower[axis]) * inverse_cell_size[axis];
+    // Compared in double before converting, so out-of-range values never overflow the int.
+    if (!(f >= 1.0)) return 0;
+    if (f >= double(resolution[axis])) return resolution[axis] - 1;
+    return static_cast<int>(f);
+}
+
+Aabb GridGeometry::cell_box(int x, int y, int z) const {
+    const Vector3 lo(x, y, z), hi(x + 1, y + 1, z + 1);
+    return Aabb(bounds.lower + lo.cwiseProduct(cell_size),
+                bounds.lower + hi.cwiseProduct(cell_size));
+}
+
+GridGeometry choose_grid_geometry(const Aabb& bounds, std::size_t count, double cells_per_primitive,
+                                  int max_resolution) {
+    GridGeometry grid;
+    grid.bounds = bounds;
+    const Vector3 extent = bounds.diagonal();
+    const double target_cells = std::max(1.0, cells_per_primitive * double(count));
+    std::array<bool, 3> free{extent.x() > 0.0, extent.y() > 0.0, extent.z() > 0.0};
+    grid.resolution = {1, 1, 1};
+    // Axes that would get fewer than one cell are fixed at one and the cell edge is chosen
+    // again over the others, so a flat or nearly flat scene spreads its cells over its plane.
+    for (int round = 0; round < 3; ++round) {
+        int dimensions = 0;
+        double measure = 1.0;
+        for (int axis = 0; axis < 3; ++axis) {
+            if (!free[axis]) continue;
+            ++dimensions;
+            measure *= extent[axis];
+        }
+        if (dimensions == 0) break;
+        const double edge = std::pow(measure / target_cells, 1.0 / dimensions);
+        bool fixed_one = false;
+        for (int axis = 0; axis < 3; ++axis) {
+            if (!free[axis]) continue;
+            const double cells = std::round(extent[axis] / edge);
+            if (!(cells >= 1.0)) {
+                free[axis] = false;
+                grid.resolution[axis] = 1;
+                fixed_one = true;
+            } else {
+                grid.resolution[axis] = int(std::min(cells, double(max_resolution)));
+            }
+        }
+        if (!fixed_one) break;
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        grid.cell_size[axis] = extent[axis] / grid.resolution[axis];
+        grid.inverse_cell_size[axis] =
+            grid.cell_size[axis] > 0.0 ? 1.0 / grid.cell_size[axis] : 0.0;
+    }
+    return grid;
+}
+
+}  // namespace detail
+
+template <class Set>
+void RegularGrid<Set>::build(const Set& set, const GridConfig& config) {
+    require(config.cells_per_primitive > 0.0 && std::isfinite(config.cells_per_primitive),
+            "RegularGrid", "cells_per_primitive", "> 0 and finite", config.cells_per_primitive);
+    require(config.max_resolution >= 1 && config.max_resolution <= 4096, "RegularGrid",
+            "max_resolution", "in [1, 4096]", config.max_resolution);
+    const auto start = std::chrono::steady_clock::now();
+    set_ = &set;
+    offsets_.clear();
+    primitives_.clear();
+    unbounded_.clear();
+    std::vector<std::uint32_t> bounded;
+    const Aabb bounds = detail::grid_bounds(set, bounded, unbounded_, scene_scale_);
+    geometry_ = detail::GridGeometry{};
+    if (!bounded.empty()) {
+        geometry_ = detail::choose_grid_geometry(bounds, bounded.size(), config.cells_per_primitive,
+                                                 config.max_resolution);
+        detail::fill_cells(set, bounded, geometry_, scene_scale_, config.triangle_box_test,
+                           offsets_, primitives_);
+    }
+    occupied_.assign((geometry_.cell_count() + 63) / 64, 0);
+    for (std::size_t c = 0; c < geometry_.cell_count(); ++c) {
+        if (offsets_[c] != offsets_[c + 1]) occupied_[c / 64] |= std::uint64_t(1) << (c % 64);
+    }
+    offsets_.shrink_to_fit();
+    primitives_.shrink_to_fit();
+    unbounded_.shrink_to_fit();
+
+    stats_ = AcceleratorStats{};
+    stats_.name = "grid";
+    stats_.primitives = set.size();
+    stats_.nodes = geometry_.cell_count();
+    stats_.references = primitives_.size() + unbounded_.size();
+    stats_.bytes = (offsets_.capacity() + primitives_.capacity() + unbounded_.capacity()) *
+                       sizeof(std::uint32_t) +
+                   occupied_.capacity() * sizeof(std::uint64_t);
+    std::size_t empty = 0;
+    for (std::size_t c = 0; c < geometry_.cell_count(); ++c)
+        empty += offsets_[c] == offsets_[c + 1];
+    std::ostringstream details;
+    details.precision(3);
+    details << "resolution " << geometry_.resolution[0] << "x" << geometry_.resolution[1] << "x"
+            << geometry_.resolution[2] << ", "
+            << (bounded.empty() ? 0.0 : double(primitives_.size()) / double(bounded.size()))
+            << " references per primitive, "
+            << (stats_.nodes ? 100.0 * double(empty) / double(stats_.nodes) : 0.0)
+            << "% empty cells, " << unbounded_.size() << " unbounded";
+    stats_.details = details.str();
+    stats_.build_milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+template <class Set>
+std::span<const std::uint32_t> RegularGrid<Set>::cell_primitives(int x, int y, int z) const {
+    const std::size_t cell = geometry_.cell_index(x, y, z);
+    return std::span<const std::uint32_t>(primitives_)
+        .subspan(offsets_[cell], offsets_[cell + 1] - offsets_[cell]);
+}
+
+template <class Set>
+bool RegularGrid<Set>::intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
+    TraversalCounters unused;
+    return intersect_impl<false>(ray, record, scratch, unused);
+}
+
+template <class Set>
+bool RegularGrid<Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
+    TraversalCounters unused;
+    return occluded_impl<false>(ray, scratch, unused);
+}
+
+template <class Set>
+bool RegularGrid<Set>::intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                                         TraversalCounters& counters) const {
+    return intersect_impl<true>(ray, record, scratch, counters);
+}
+
+template <class Set>
+bool RegularGrid<Set>::occluded_counted(const Ray& ray, QueryScratch& scratch,
+                                        TraversalCounters& counters) const {
+    return occluded_impl<true>(ray, scratch, counters);
+}
+
+template <class Set>
+template <bool kCount>
+bool RegularGrid<Set>::intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                                      TraversalCounters& counters) const {
+    if (set_ == nullptr || !is_valid(ray)) return false;
+    const auto prepared = set_->prepare(ray, scratch);
+    HitRecord best;
+    best.t = ray.t_max;
+    bool found = false;
+    for (const std::uint32_t primitive : unbounded_) {
+        if constexpr (kCount) ++counters.primitives_tested;
+        found |= set_->intersect(primitive, prepared, best);
+    }
+    const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    double t_enter, t_exit;
+    if constexpr (kCount) ++counters.boxes_tested;
+    if (!primitives_.empty() &&
+        geometry_.bounds.intersect(ray, inverse_direction, t_enter, t_exit)) {
+        const detail::StopRule stop(ray, scene_scale_);
+        detail::Mailbox mailbox;
+        // A hit beyond the current cell's exit is kept, not accepted: a primitive in a later
+        // cell may be nearer. The search ends after the first cell that ends beyond the best.
+        detail::walk_cells(geometry_, ray, inverse_direction, t_enter, t_exit,
+                           [&](std::size_t cell, double cell_exit) {
+                               if constexpr (kCount) ++counters.nodes_visited;
+                               if (!is_occupied(cell)) return false;
+                               const std::uint32_t end = offsets_[cell + 1];
+                               for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
+                                   const std::uint32_t primitive = primitives_[k];
+                                   if (!mailbox.first_visit(primitive)) continue;
+                                   if constexpr (kCount) ++counters.primitives_tested;
+                                   found |= set_->intersect(primitive, prepared, best);
+                               }
+                               return found && stop.done(best.t, cell_exit);
+                           });
+    }
+    if (found) record = best;
+    return found;
+}
+
+template <class Set>
+template <bool kCount>
+bool RegularGrid<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
+                                     TraversalCounters& counters) const {
+    if (set_ == nullptr || !is_valid(ray)) return false;
+    const auto prepared = set_->prepare(ray, scratch);
+    for (const std::uint32_t primitive : unbounded_) {
+        if constexpr (kCount) ++counters.primitives_tested;
+        if (set_->occluded(primitive, prepared)) return true;
+    }
+    const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    double t_enter, t_exit;
+    if constexpr (kCount) ++counters.boxes_tested;
+    if (primitives_.empty() || !geometry_.bounds.intersect(ray, inverse_direction, t_enter, t_exit))
+        return false;
+    detail::Mailbox mailbox;
+    bool hit = false;
+    detail::walk_cells(geometry_, ray, inverse_direction, t_enter, t_exit,
+                       [&](std::size_t cell, double) {
+                           if constexpr (kCount) ++counters.nodes_visited;
+                           if (!is_occupied(cell)) return false;
+                           const std::uint32_t end = offsets_[cell + 1];
+                           for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
+                               const std::uint32_t primitive = primitives_[k];
+                               if (!mailbox.first_visit(primitive)) continue;
+                               if constexpr (kCount) ++counters.primitives_tested;
+                               if (set_->occluded(primitive, prepared)) return hit = true;
+                           }
+                           return false;
+                       });
+    return hit;
+}
+
+template <class Set>
+void RegularGrid<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
+                                QueryScratch& scratch) const {
+    if (set_ == nullptr || !is_valid(ray)) return;
+    const auto prepared = set_->prepare(ray, scratch);
+    const std::size_t first = hits.size();
+    auto test = [&](std::uint32_t primitive) {
+        HitRecord record;
+        record.t = ray.t_max;
+        if (set_->intersect(primitive, prepared, record)) hits.push_back(record);
+    };
+    for (const std::uint32_t primitive : unbounded_) test(primitive);
+    const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    double t_enter, t_exit;
+    if (!primitives_.empty() &&
+        geometry_.bounds.intersect(ray, inverse_direction, t_enter, t_exit)) {
+        detail::Mailbox mailbox;
+        detail::walk_cells(geometry_, ray, inverse_direction, t_enter, t_exit,
+                           [&](std::size_t cell, double) {
+                               if (!is_occupied(cell)) return false;
+                               const std::uint32_t end = offsets_[cell + 1];
+                               for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
+                                   if (mailbox.first_visit(primitives_[k])) test(primitives_[k]);
+                               }
+                               return false;
+                           });
+    }
+    detail::drop_repeated_hits<Set>(hits, first);
+}
+
+template class RegularGrid<TriangleSet<float>>;
+template class RegularGrid<TriangleSet<double>>;
+template class RegularGrid<ShapeSet>;
+
+}  // namespace csgrt
