@@ -208,6 +208,27 @@ private:
     double absolute_;
 };
 
+/// The part [t_enter, t_exit] of [ray.t_min, ray.t_max] inside `box`, or false: the same
+/// conservative slab test as Aabb::intersect (Ize, "Robust BVH Ray Traversal", JCGT 2013:
+/// t_far grown by 2 gamma(3) |t_far|, NaN slabs ignored), written out per axis so it inlines
+/// into the traversal, which calls it once per grid entered.
+inline bool clip_to_box(const Aabb& box, const Ray& ray, const Vector3& inverse_direction,
+                        double& t_enter, double& t_exit) {
+    double t0 = ray.t_min, t1 = ray.t_max;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double a = (box.lower[axis] - ray.origin[axis]) * inverse_direction[axis];
+        const double b = (box.upper[axis] - ray.origin[axis]) * inverse_direction[axis];
+        const double t_near = a < b ? a : b;
+        double t_far = a < b ? b : a;
+        t_far *= t_far >= 0.0 ? 1.0 + 2.0 * gamma(3) : 1.0 - 2.0 * gamma(3);
+        t0 = t_near > t0 ? t_near : t0;
+        t1 = t_far < t1 ? t_far : t1;
+    }
+    t_enter = t0;
+    t_exit = t1;
+    return t0 <= t1;
+}
+
 /// Walks the cells of `grid` that the ray crosses between t_enter and t_exit (a part of the
 /// ray inside grid.bounds), in order, with the 3D-DDA of Amanatides & Woo 1987. Calls
 /// visit(cell index, cell exit t) for each and stops when it returns true.

@@ -19,21 +19,33 @@ namespace {
 /// triangle test; the decision is not sensitive to them within a factor of two.
 constexpr double kSubGridCost = 2.0;
 constexpr double kCellCost = 0.3;
+constexpr std::size_t kMaxReferenceGrowth = 8;
 
-/// The expected cost of a ray that crosses a cell of surface area `cell_area` when the cell
-/// holds the sub-grid `geometry` with lists `offsets`: the sub-grid's box clip, plus each
-/// sub-cell's step and list weighted by the chance a ray through the cell crosses it (the
-/// ratio of surface areas, as in the SAH: Goldsmith & Salmon 1987, MacDonald & Booth 1990).
-double sub_grid_cost(const detail::GridGeometry& geometry,
-                     const std::vector<std::uint32_t>& offsets, double cell_area) {
+/// Whether a cell listing `count` primitives should hold the sub-grid `geometry` (with lists
+/// `offsets`) instead. Three conditions:
+/// - it separates them: no sub-cell lists all of them;
+/// - it does not multiply them: at most kMaxReferenceGrowth references per primitive.
+///   Primitives no sub-grid can separate (identical or nearly so, or all crossing one spot)
+///   would be listed again in every sub-cell and, beyond the mailbox's slots, tested again in
+///   each;
+/// - it is cheaper for a random ray through the cell: the sub-grid's box clip, plus each
+///   sub-cell's step and list weighted by the chance a ray through the cell crosses that
+///   sub-cell (the ratio of surface areas, as in the SAH: Goldsmith & Salmon 1987, MacDonald
+///   & Booth 1990), against testing the whole list.
+bool sub_grid_pays(const detail::GridGeometry& geometry, const std::vector<std::uint32_t>& offsets,
+                   std::size_t count, double cell_area) {
+    if (offsets.back() > kMaxReferenceGrowth * count) return false;
     const Vector3 size = geometry.cell_size;
     const double sub_cell_area =
         2.0 * (size.x() * size.y() + size.y() * size.z() + size.z() * size.x());
     const double crossing = sub_cell_area / cell_area;
     double cost = kSubGridCost;
-    for (std::size_t c = 0; c < geometry.cell_count(); ++c)
-        cost += crossing * (kCellCost + double(offsets[c + 1] - offsets[c]));
-    return cost;
+    for (std::size_t c = 0; c < geometry.cell_count(); ++c) {
+        const std::uint32_t listed = offsets[c + 1] - offsets[c];
+        if (listed == count) return false;
+        cost += crossing * (kCellCost + double(listed));
+    }
+    return cost < double(count);
 }
 
 /// Nearest-hit search: a hit beyond the current cell's exit is kept, not accepted, and the
@@ -227,7 +239,7 @@ std::uint32_t HierarchicalGrid<Set>::add_grid(const Set& set, const detail::Grid
                             config_.max_resolution);
                         detail::fill_cells(set, members, sub, scene_scale_,
                                            config_.triangle_box_test, sub_offsets, sub_lists);
-                        if (sub_grid_cost(sub, sub_offsets, cell_area) < double(members.size())) {
+                        if (sub_grid_pays(sub, sub_offsets, members.size(), cell_area)) {
                             const std::uint32_t child =
                                 add_grid(set, sub, sub_offsets, sub_lists, depth + 1);
                             cells_[first + c] = Cell{child, kSubGrid};
@@ -245,13 +257,31 @@ std::uint32_t HierarchicalGrid<Set>::add_grid(const Set& set, const detail::Grid
 }
 
 template <class Set>
+std::span<const std::uint32_t> HierarchicalGrid<Set>::primitives_at(const Point3& p) const {
+    std::uint32_t grid_index = 0;
+    while (grid_index < grids_.size()) {
+        const Grid& grid = grids_[grid_index];
+        if (!grid.geometry.bounds.contains(p)) return {};
+        const Cell& cell = cells_[grid.first_cell + grid.geometry.cell_index(
+                                                        grid.geometry.cell_coordinate(p.x(), 0),
+                                                        grid.geometry.cell_coordinate(p.y(), 1),
+                                                        grid.geometry.cell_coordinate(p.z(), 2))];
+        if (cell.count != kSubGrid)
+            return std::span<const std::uint32_t>(primitives_.data() + cell.begin, cell.count);
+        grid_index = cell.begin;
+    }
+    return {};
+}
+
+template <class Set>
 template <class Visitor>
 bool HierarchicalGrid<Set>::traverse(std::uint32_t grid_index, const Ray& ray,
                                      const Vector3& inverse_direction, Visitor& visitor) const {
     const Grid& grid = grids_[grid_index];
     double t_enter, t_exit;
     visitor.count_box();
-    if (!grid.geometry.bounds.intersect(ray, inverse_direction, t_enter, t_exit)) return false;
+    if (!detail::clip_to_box(grid.geometry.bounds, ray, inverse_direction, t_enter, t_exit))
+        return false;
     bool stop = false;
     detail::walk_cells(grid.geometry, ray, inverse_direction, t_enter, t_exit,
                        [&](std::size_t cell_index, double cell_exit) {

@@ -14,14 +14,6 @@ namespace csgrt {
 
 namespace detail {
 
-int GridGeometry::cell_coordinate(double p, int axis) const {
-    const double f = (p - bounds.lower[axis]) * inverse_cell_size[axis];
-    // Compared in double before converting, so out-of-range values never overflow the int.
-    if (!(f >= 1.0)) return 0;
-    if (f >= double(resolution[axis])) return resolution[axis] - 1;
-    return static_cast<int>(f);
-}
-
 Aabb GridGeometry::cell_box(int x, int y, int z) const {
     const Vector3 lo(x, y, z), hi(x + 1, y + 1, z + 1);
     return Aabb(bounds.lower + lo.cwiseProduct(cell_size),
@@ -172,7 +164,7 @@ bool RegularGrid<Set>::intersect_impl(const Ray& ray, HitRecord& record, QuerySc
     double t_enter, t_exit;
     if constexpr (kCount) ++counters.boxes_tested;
     if (!primitives_.empty() &&
-        geometry_.bounds.intersect(ray, inverse_direction, t_enter, t_exit)) {
+        detail::clip_to_box(geometry_.bounds, ray, inverse_direction, t_enter, t_exit)) {
         const detail::StopRule stop(ray, scene_scale_);
         detail::Mailbox mailbox;
         // A hit beyond the current cell's exit is kept, not accepted: a primitive in a later
@@ -208,7 +200,8 @@ bool RegularGrid<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     double t_enter, t_exit;
     if constexpr (kCount) ++counters.boxes_tested;
-    if (primitives_.empty() || !geometry_.bounds.intersect(ray, inverse_direction, t_enter, t_exit))
+    if (primitives_.empty() ||
+        !detail::clip_to_box(geometry_.bounds, ray, inverse_direction, t_enter, t_exit))
         return false;
     detail::Mailbox mailbox;
     bool hit = false;
@@ -243,7 +236,7 @@ void RegularGrid<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     double t_enter, t_exit;
     if (!primitives_.empty() &&
-        geometry_.bounds.intersect(ray, inverse_direction, t_enter, t_exit)) {
+        detail::clip_to_box(geometry_.bounds, ray, inverse_direction, t_enter, t_exit)) {
         detail::Mailbox mailbox;
         detail::walk_cells(geometry_, ray, inverse_direction, t_enter, t_exit,
                            [&](std::size_t cell, double) {

@@ -298,13 +298,25 @@ inline double boundary_near(const detail::GridGeometry& grid, int axis, double x
     return grid.bounds.lower[axis] + i * grid.cell_size[axis];
 }
 
-/// A cube [990, 1010]^3 framed by two big triangles (its bounds whatever else is inside) plus
-/// `inner`: a scene far enough from the origin for float rounding to be coarse (6e-5).
+/// The box [990, 1010]^3 framed by its bottom and top faces (z = 990 and z = 1010, eight
+/// triangles each, so its bounds do not depend on what else is inside) plus `inner`: a scene
+/// far enough from the origin for float rounding to be coarse (6e-5), open to rays along x
+/// and y.
 inline TestMesh framed(const TestMesh& inner) {
     TestMesh mesh;
-    mesh.vertices = {{990, 990, 990},    {1010, 990, 990},  {990, 1010, 990},
-                     {1010, 1010, 1010}, {990, 1010, 1010}, {1010, 990, 1010}};
-    mesh.triangles = {{0, 1, 2}, {3, 4, 5}};
+    for (const double z : {990.0, 1010.0}) {
+        for (int i = 0; i < 2; ++i) {
+            for (int j = 0; j < 2; ++j) {
+                const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
+                const double x = 990.0 + 10.0 * i, y = 990.0 + 10.0 * j;
+                mesh.vertices.insert(mesh.vertices.end(),
+                                     {Point3(x, y, z), Point3(x + 10, y, z),
+                                      Point3(x + 10, y + 10, z), Point3(x, y + 10, z)});
+                mesh.triangles.push_back({base, base + 1, base + 2});
+                mesh.triangles.push_back({base, base + 2, base + 3});
+            }
+        }
+    }
     append(mesh, inner);
     return mesh;
 }

@@ -30,14 +30,15 @@ struct HierarchicalGridConfig {
 /// Tracing", Graphics Interface 1989: a coarse top grid (N^0.6 cells, Ize et al. 2007) whose
 /// crowded cells hold grids of their own, recursively. Unlike Klimaszewski & Sederberg, "Faster
 /// Ray Tracing Using Adaptive Grids", IEEE CG&A 1997, it does not search for uniform regions
-/// spanning several cells: each cell decides alone. A cell gets a sub-grid only when an
-/// estimate of a random ray's cost says it pays: cells it would visit plus primitives it would
-/// test, each weighted by the chance that a ray crossing the cell crosses the sub-cell (the
-/// ratio of surface areas), against testing the cell's list. So cells of identical or huge
-/// primitives stay lists. Each sub-grid is built from its cell's list (not from the whole
-/// set) over the cell's box shrunk to the primitives in it. Traversal runs the regular grid's
-/// DDA at every level, descending into sub-grids, with one mailbox and one stopping rule for
-/// the whole ray.
+/// spanning several cells: each cell decides alone. A cell gets a sub-grid only when the
+/// sub-grid separates its primitives (no sub-cell lists them all, few references per
+/// primitive) and an estimate of a random ray's cost says it pays: cells it would visit plus
+/// primitives it would test, each weighted by the chance that a ray crossing the cell crosses the
+/// sub-cell (the ratio of surface areas), against testing the cell's list. So cells of identical or
+/// huge primitives stay lists. Each sub-grid is built from its cell's list (not from the whole set)
+/// over the cell's box shrunk to the primitives in it. Traversal runs the regular grid's DDA at
+/// every level, descending into sub-grids, with one mailbox and one stopping rule for the whole
+/// ray.
 template <class Set>
 class HierarchicalGrid final : public Accelerator<Set> {
 public:
@@ -60,6 +61,9 @@ public:
     const detail::GridGeometry& geometry(std::size_t grid) const { return grids_[grid].geometry; }
     /// Deepest nesting built (0: only the top grid).
     int depth() const { return depth_; }
+    /// The list of the innermost cell holding point p (empty outside every grid): what a ray
+    /// through p tests there. For tests and reports.
+    std::span<const std::uint32_t> primitives_at(const Point3& p) const;
 
 private:
     /// One uniform grid of the hierarchy; its cells are cells_[first_cell ..].

@@ -49,7 +49,13 @@ struct GridGeometry {
     }
     /// The cell coordinate of position p along `axis`, clamped into [0, resolution - 1] (so
     /// points on or outside the faces belong to the outer cells; NaN gives 0).
-    int cell_coordinate(double p, int axis) const;
+    int cell_coordinate(double p, int axis) const {
+        const double f = (p - bounds.lower[axis]) * inverse_cell_size[axis];
+        // Compared in double before converting, so out-of-range values never overflow the int.
+        if (!(f >= 1.0)) return 0;
+        if (f >= double(resolution[axis])) return resolution[axis] - 1;
+        return static_cast<int>(f);
+    }
     Aabb cell_box(int x, int y, int z) const;
 };
 
