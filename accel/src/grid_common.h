@@ -126,6 +126,17 @@ void for_each_overlapped_cell(const Set& set, std::uint32_t primitive, const Gri
     }
 }
 
+/// Asks the memory system for the triangles of a cell's list before they are tested, so that
+/// their cache misses overlap instead of queueing one per test (incoherent rays miss on most
+/// of them). Only triangle sets expose where a primitive's data lives.
+template <class Set>
+inline void prefetch_primitives(const Set& set, const std::uint32_t* begin,
+                                const std::uint32_t* end) {
+    if constexpr (HasTriangleCorners<Set>) {
+        for (const std::uint32_t* p = begin; p != end; ++p) __builtin_prefetch(&set.corner(*p, 0));
+    }
+}
+
 /// Fills the CSR cell lists of `grid` with `members` (primitive indices, ascending): a count
 /// pass, a prefix sum, and a fill pass, so the lists are allocated once at their exact size.
 /// Cell c lists primitives[offsets[c] .. offsets[c + 1]).
@@ -229,6 +240,9 @@ inline bool clip_to_box(const Aabb& box, const Ray& ray, const Vector3& inverse_
     return t0 <= t1;
 }
 
+/// Jumps over fewer empty cells than this cost more than stepping through them.
+inline constexpr int kMinimumJump = 3;
+
 /// Walks the cells of `grid` that the ray crosses between t_enter and t_exit (a part of the
 /// ray inside grid.bounds), in order, with the 3D-DDA of Amanatides & Woo 1987. Calls
 /// visit(cell index, cell exit t) for each and stops when it returns true.
@@ -242,9 +256,17 @@ inline bool clip_to_box(const Aabb& box, const Ray& ray, const Vector3& inverse_
 /// increasing for a ray from absurdly far away). An axis whose direction reciprocal is
 /// infinite (zero or denormal component) never steps: the ray moves less than a rounding
 /// error along it inside the grid.
-template <class Visit>
+///
+/// `empty_radius(cell index)` may report that every cell within Chebyshev distance r - 1 of
+/// the cell is empty (r = 0 or 1: nothing known). For r >= kMinimumJump the walk then leaves
+/// that cube of empty cells in one jump, as proximity clouds do (Cohen & Sheffer, "Proximity
+/// Clouds", The Visual Computer 1994): the axis whose boundary r - 1 cells on is nearest
+/// crosses r planes, the others the planes they cross before it, so the walk lands in the
+/// cell the DDA would have reached. Counting those planes rounds only where the ray passes
+/// within a rounding error of a cell edge, where the cell padding covers either choice.
+template <class Visit, class EmptyRadius>
 inline void walk_cells(const GridGeometry& grid, const Ray& ray, const Vector3& inverse_direction,
-                       double t_enter, double t_exit, Visit&& visit) {
+                       double t_enter, double t_exit, Visit&& visit, EmptyRadius&& empty_radius) {
     const Point3 entry = ray.at(t_enter);
     int cell[3], step[3], end[3];
     double t_next[3], t_delta[3];
@@ -276,6 +298,35 @@ inline void walk_cells(const GridGeometry& grid, const Ray& ray, const Vector3& 
         const double t_cross = std::min(tx, std::min(ty, tz));
         if (visit(std::size_t(index), t_cross < t_exit ? t_cross : t_exit)) return;
         if (!(t_cross < t_exit)) return;
+        const int radius = empty_radius(std::size_t(index));
+        if (radius >= kMinimumJump) {
+            const int reach = radius - 1;
+            const double lx = tx + reach * t_delta[0], ly = ty + reach * t_delta[1],
+                         lz = tz + reach * t_delta[2];
+            const double t_leave = std::min(lx, std::min(ly, lz));
+            if (!(t_leave < t_exit)) return;
+            // Planes of one axis crossed before t_leave (at most reach), or reach + 1 for the
+            // axis that leaves the cube.
+            auto crossed = [&](double t, double l, double delta) {
+                if (l == t_leave) return reach + 1;
+                if (!(t < t_leave)) return 0;
+                const double planes = std::ceil((t_leave - t) / delta);
+                return planes < reach ? int(planes) : reach;
+            };
+            const int mx = crossed(tx, lx, t_delta[0]), my = crossed(ty, ly, t_delta[1]),
+                      mz = crossed(tz, lz, t_delta[2]);
+            x += step[0] * mx;
+            y += step[1] * my;
+            z += step[2] * mz;
+            if (x < 0 || x >= grid.resolution[0] || y < 0 || y >= grid.resolution[1] || z < 0 ||
+                z >= grid.resolution[2])
+                return;
+            tx += mx * t_delta[0];
+            ty += my * t_delta[1];
+            tz += mz * t_delta[2];
+            index = std::ptrdiff_t(grid.cell_index(x, y, z));
+            continue;
+        }
         if (t_cross == tx) {
             x += step[0];
             if (x == end[0]) return;
@@ -293,6 +344,13 @@ inline void walk_cells(const GridGeometry& grid, const Ray& ray, const Vector3& 
             tz += t_delta[2];
         }
     }
+}
+
+/// walk_cells without jumps.
+template <class Visit>
+inline void walk_cells(const GridGeometry& grid, const Ray& ray, const Vector3& inverse_direction,
+                       double t_enter, double t_exit, Visit&& visit) {
+    walk_cells(grid, ray, inverse_direction, t_enter, t_exit, visit, [](std::size_t) { return 0; });
 }
 
 /// The set member a record belongs to: shape sets name it in `object`, triangle sets in

@@ -73,6 +73,7 @@ struct NearestVisitor {
         if constexpr (kCount) ++counters.nodes_visited;
     }
     bool leaf(std::span<const std::uint32_t> list) {
+        detail::prefetch_primitives(set, list.data(), list.data() + list.size());
         for (const std::uint32_t primitive : list) {
             if (!mailbox.first_visit(primitive)) continue;
             if constexpr (kCount) ++counters.primitives_tested;
@@ -102,6 +103,7 @@ struct AnyVisitor {
         if constexpr (kCount) ++counters.nodes_visited;
     }
     bool leaf(std::span<const std::uint32_t> list) {
+        detail::prefetch_primitives(set, list.data(), list.data() + list.size());
         for (const std::uint32_t primitive : list) {
             if (!mailbox.first_visit(primitive)) continue;
             if constexpr (kCount) ++counters.primitives_tested;
@@ -128,6 +130,7 @@ struct AllVisitor {
     void count_box() {}
     void count_cell() {}
     bool leaf(std::span<const std::uint32_t> list) {
+        detail::prefetch_primitives(set, list.data(), list.data() + list.size());
         for (const std::uint32_t primitive : list) {
             if (!mailbox.first_visit(primitive)) continue;
             HitRecord record;

@@ -64,6 +64,72 @@ GridGeometry choose_grid_geometry(const Aabb& bounds, std::size_t count, double 
 
 }  // namespace detail
 
+namespace {
+
+/// Distances beyond this many cells are recorded as this many (they fit a byte, and longer
+/// jumps are rare).
+constexpr int kRadiusCap = 16;
+
+/// One pass of the separable Chebyshev distance transform along a line of `count` cells
+/// `stride` apart: g(j) = min over j' of max(|j - j'|, f(j')), with f capped at kRadiusCap so
+/// only |j - j'| < kRadiusCap matters. (The L-infinity distance to the nearest occupied
+/// cell is the min over occupied cells of the max of the three per-axis distances, so
+/// taking the 1D distance along x and then this pass along y and along z gives it exactly.)
+void chebyshev_pass(std::uint8_t* line, int count, std::ptrdiff_t stride,
+                    std::vector<std::uint8_t>& buffer) {
+    buffer.resize(std::size_t(count));
+    for (int j = 0; j < count; ++j) buffer[std::size_t(j)] = line[j * stride];
+    for (int j = 0; j < count; ++j) {
+        int best = buffer[std::size_t(j)];
+        for (int offset = 1; offset < best; ++offset) {
+            if (j - offset >= 0)
+                best = std::min(best, std::max(offset, int(buffer[std::size_t(j - offset)])));
+            if (j + offset < count)
+                best = std::min(best, std::max(offset, int(buffer[std::size_t(j + offset)])));
+        }
+        line[j * stride] = std::uint8_t(best);
+    }
+}
+
+/// For every cell, the Chebyshev distance in cells to the nearest cell with a non-empty list
+/// (0 for those), capped at kRadiusCap: a cell at distance r has only empty cells within
+/// distance r - 1, which the walk may jump over.
+std::vector<std::uint8_t> empty_radii(const detail::GridGeometry& grid,
+                                      const std::vector<std::uint32_t>& offsets) {
+    const int nx = grid.resolution[0], ny = grid.resolution[1], nz = grid.resolution[2];
+    std::vector<std::uint8_t> radius(grid.cell_count(), std::uint8_t(kRadiusCap));
+    // Along x: the distance to the nearest occupied cell of the row, from both sides.
+    for (int z = 0; z < nz; ++z) {
+        for (int y = 0; y < ny; ++y) {
+            std::uint8_t* row = &radius[grid.cell_index(0, y, z)];
+            const std::uint32_t* row_offsets = &offsets[grid.cell_index(0, y, z)];
+            int distance = kRadiusCap;
+            for (int x = 0; x < nx; ++x) {
+                distance =
+                    row_offsets[x] != row_offsets[x + 1] ? 0 : std::min(distance + 1, kRadiusCap);
+                row[x] = std::uint8_t(distance);
+            }
+            distance = kRadiusCap;
+            for (int x = nx - 1; x >= 0; --x) {
+                distance = row[x] == 0 ? 0 : std::min(distance + 1, kRadiusCap);
+                row[x] = std::uint8_t(std::min<int>(row[x], distance));
+            }
+        }
+    }
+    std::vector<std::uint8_t> buffer;
+    for (int z = 0; z < nz; ++z) {
+        for (int x = 0; x < nx; ++x)
+            chebyshev_pass(&radius[grid.cell_index(x, 0, z)], ny, nx, buffer);
+    }
+    for (int y = 0; y < ny; ++y) {
+        for (int x = 0; x < nx; ++x)
+            chebyshev_pass(&radius[grid.cell_index(x, y, 0)], nz, std::ptrdiff_t(nx) * ny, buffer);
+    }
+    return radius;
+}
+
+}  // namespace
+
 template <class Set>
 void RegularGrid<Set>::build(const Set& set, const GridConfig& config) {
     require(config.cells_per_primitive > 0.0 && std::isfinite(config.cells_per_primitive),
@@ -84,6 +150,8 @@ void RegularGrid<Set>::build(const Set& set, const GridConfig& config) {
         detail::fill_cells(set, bounded, geometry_, scene_scale_, config.triangle_box_test,
                            offsets_, primitives_);
     }
+    empty_radius_ =
+        bounded.empty() ? std::vector<std::uint8_t>{} : empty_radii(geometry_, offsets_);
     occupied_.assign((geometry_.cell_count() + 63) / 64, 0);
     for (std::size_t c = 0; c < geometry_.cell_count(); ++c) {
         if (offsets_[c] != offsets_[c + 1]) occupied_[c / 64] |= std::uint64_t(1) << (c % 64);
@@ -99,7 +167,7 @@ void RegularGrid<Set>::build(const Set& set, const GridConfig& config) {
     stats_.references = primitives_.size() + unbounded_.size();
     stats_.bytes = (offsets_.capacity() + primitives_.capacity() + unbounded_.capacity()) *
                        sizeof(std::uint32_t) +
-                   occupied_.capacity() * sizeof(std::uint64_t);
+                   occupied_.capacity() * sizeof(std::uint64_t) + empty_radius_.capacity();
     std::size_t empty = 0;
     for (std::size_t c = 0; c < geometry_.cell_count(); ++c)
         empty += offsets_[c] == offsets_[c + 1];
@@ -169,19 +237,23 @@ bool RegularGrid<Set>::intersect_impl(const Ray& ray, HitRecord& record, QuerySc
         detail::Mailbox mailbox;
         // A hit beyond the current cell's exit is kept, not accepted: a primitive in a later
         // cell may be nearer. The search ends after the first cell that ends beyond the best.
-        detail::walk_cells(geometry_, ray, inverse_direction, t_enter, t_exit,
-                           [&](std::size_t cell, double cell_exit) {
-                               if constexpr (kCount) ++counters.nodes_visited;
-                               if (!is_occupied(cell)) return false;
-                               const std::uint32_t end = offsets_[cell + 1];
-                               for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
-                                   const std::uint32_t primitive = primitives_[k];
-                                   if (!mailbox.first_visit(primitive)) continue;
-                                   if constexpr (kCount) ++counters.primitives_tested;
-                                   found |= set_->intersect(primitive, prepared, best);
-                               }
-                               return found && stop.done(best.t, cell_exit);
-                           });
+        detail::walk_cells(
+            geometry_, ray, inverse_direction, t_enter, t_exit,
+            [&](std::size_t cell, double cell_exit) {
+                if constexpr (kCount) ++counters.nodes_visited;
+                if (!is_occupied(cell)) return false;
+                const std::uint32_t end = offsets_[cell + 1];
+                detail::prefetch_primitives(*set_, &primitives_[offsets_[cell]],
+                                            primitives_.data() + end);
+                for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
+                    const std::uint32_t primitive = primitives_[k];
+                    if (!mailbox.first_visit(primitive)) continue;
+                    if constexpr (kCount) ++counters.primitives_tested;
+                    found |= set_->intersect(primitive, prepared, best);
+                }
+                return found && stop.done(best.t, cell_exit);
+            },
+            [&](std::size_t cell) { return int(empty_radius_[cell]); });
     }
     if (found) record = best;
     return found;
@@ -205,19 +277,23 @@ bool RegularGrid<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
         return false;
     detail::Mailbox mailbox;
     bool hit = false;
-    detail::walk_cells(geometry_, ray, inverse_direction, t_enter, t_exit,
-                       [&](std::size_t cell, double) {
-                           if constexpr (kCount) ++counters.nodes_visited;
-                           if (!is_occupied(cell)) return false;
-                           const std::uint32_t end = offsets_[cell + 1];
-                           for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
-                               const std::uint32_t primitive = primitives_[k];
-                               if (!mailbox.first_visit(primitive)) continue;
-                               if constexpr (kCount) ++counters.primitives_tested;
-                               if (set_->occluded(primitive, prepared)) return hit = true;
-                           }
-                           return false;
-                       });
+    detail::walk_cells(
+        geometry_, ray, inverse_direction, t_enter, t_exit,
+        [&](std::size_t cell, double) {
+            if constexpr (kCount) ++counters.nodes_visited;
+            if (!is_occupied(cell)) return false;
+            const std::uint32_t end = offsets_[cell + 1];
+            detail::prefetch_primitives(*set_, &primitives_[offsets_[cell]],
+                                        primitives_.data() + end);
+            for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
+                const std::uint32_t primitive = primitives_[k];
+                if (!mailbox.first_visit(primitive)) continue;
+                if constexpr (kCount) ++counters.primitives_tested;
+                if (set_->occluded(primitive, prepared)) return hit = true;
+            }
+            return false;
+        },
+        [&](std::size_t cell) { return int(empty_radius_[cell]); });
     return hit;
 }
 
@@ -238,15 +314,17 @@ void RegularGrid<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
     if (!primitives_.empty() &&
         detail::clip_to_box(geometry_.bounds, ray, inverse_direction, t_enter, t_exit)) {
         detail::Mailbox mailbox;
-        detail::walk_cells(geometry_, ray, inverse_direction, t_enter, t_exit,
-                           [&](std::size_t cell, double) {
-                               if (!is_occupied(cell)) return false;
-                               const std::uint32_t end = offsets_[cell + 1];
-                               for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
-                                   if (mailbox.first_visit(primitives_[k])) test(primitives_[k]);
-                               }
-                               return false;
-                           });
+        detail::walk_cells(
+            geometry_, ray, inverse_direction, t_enter, t_exit,
+            [&](std::size_t cell, double) {
+                if (!is_occupied(cell)) return false;
+                const std::uint32_t end = offsets_[cell + 1];
+                for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
+                    if (mailbox.first_visit(primitives_[k])) test(primitives_[k]);
+                }
+                return false;
+            },
+            [&](std::size_t cell) { return int(empty_radius_[cell]); });
     }
     detail::drop_repeated_hits<Set>(hits, first);
 }

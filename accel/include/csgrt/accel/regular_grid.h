@@ -96,6 +96,12 @@ public:
     const detail::GridGeometry& geometry() const { return geometry_; }
     /// The primitives listed in cell (x, y, z), in ascending index order.
     std::span<const std::uint32_t> cell_primitives(int x, int y, int z) const;
+    /// The Chebyshev distance, in cells and capped at 16, from cell (x, y, z) to the nearest
+    /// cell with primitives (0 for those): the walk jumps over the empty cells within that
+    /// distance minus one.
+    int empty_radius(int x, int y, int z) const {
+        return empty_radius_[geometry_.cell_index(x, y, z)];
+    }
     /// Primitives every ray tests because their boxes are unbounded or empty.
     std::span<const std::uint32_t> unbounded_primitives() const { return unbounded_; }
 
@@ -118,6 +124,9 @@ private:
     /// One bit per cell, set when its list is not empty: most cells of a mesh's grid are
     /// empty, and this 32 times smaller array stays in cache while the rays cross them.
     std::vector<std::uint64_t> occupied_;
+    /// Per cell, the Chebyshev distance (in cells, capped at 16) to the nearest occupied
+    /// cell: the walk jumps over the empty cells around a cell in one step.
+    std::vector<std::uint8_t> empty_radius_;
     std::vector<std::uint32_t> unbounded_;
     AcceleratorStats stats_;
 };
