@@ -15,7 +15,7 @@ struct HierarchicalGridConfig {
     /// one level of nesting (N^(3 / (3 + 2 d)) for d levels). In [0, 1].
     double top_cells_exponent = 0.6;
     /// Cells listing more than this many primitives are considered for a sub-grid (>= 1).
-    int max_primitives_per_cell = 8;
+    int max_primitives_per_cell = 16;
     /// Density of each sub-grid, in cells per primitive of the cell it refines (> 0).
     double sub_cells_per_primitive = 2.0;
     /// Most levels of sub-grids below the top grid, in [0, 8] (0: a plain grid).
