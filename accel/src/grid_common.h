@@ -53,35 +53,56 @@ inline Aabb padded(const Aabb& box, double padding) {
     return Aabb(box.lower - Vector3::Constant(padding), box.upper + Vector3::Constant(padding));
 }
 
-/// Separating-axis test of a triangle against the box center +- half (Akenine-Moeller, "Fast
-/// 3D Triangle-Box Overlap Testing", JGT 6(1), 2001): the box's three axes, the triangle's
-/// normal and the nine cross products of edges and box axes. Degenerate triangles pass the
-/// normal test, which keeps them (conservatively) wherever their box is.
-inline bool triangle_overlaps_box(const std::array<Vector3, 3>& corners, const Point3& center,
-                                  const Vector3& half) {
-    const Vector3 v0 = corners[0] - center, v1 = corners[1] - center, v2 = corners[2] - center;
-    for (int axis = 0; axis < 3; ++axis) {
-        const double lo = std::min({v0[axis], v1[axis], v2[axis]});
-        const double hi = std::max({v0[axis], v1[axis], v2[axis]});
-        if (lo > half[axis] || hi < -half[axis]) return false;
-    }
-    const std::array<Vector3, 3> edges = {v1 - v0, v2 - v1, v0 - v2};
-    const Vector3 normal = edges[0].cross(edges[1]);
-    if (std::abs(normal.dot(v0)) > half.dot(normal.cwiseAbs())) return false;
-    for (const Vector3& edge : edges) {
-        for (int axis = 0; axis < 3; ++axis) {
-            // The axis e_axis x edge, written out: its component along `axis` is zero.
-            Vector3 direction = Vector3::Zero();
-            const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-            direction[a1] = -edge[a2];
-            direction[a2] = edge[a1];
-            const double p0 = direction.dot(v0), p1 = direction.dot(v1), p2 = direction.dot(v2);
-            const double radius = half.dot(direction.cwiseAbs());
-            if (std::min({p0, p1, p2}) > radius || std::max({p0, p1, p2}) < -radius) return false;
+/// The separating-axis test of one triangle against boxes of one size (a grid's cells, grown
+/// by the padding): Akenine-Moeller, "Fast 3D Triangle-Box Overlap Testing", JGT 6(1), 2001.
+/// The candidate axes are the triangle's normal and the nine cross products of its edges
+/// with the box axes (the box axes themselves are settled by the range of cells the caller
+/// visits). The triangle's extent and the box's radius along each axis are computed once per
+/// triangle, so each cell costs one dot product per axis. Degenerate triangles give zero
+/// axes, which separate nothing: they stay wherever their box is.
+class TriangleBoxTest {
+public:
+    TriangleBoxTest(const std::array<Vector3, 3>& corners, const Vector3& half) {
+        const std::array<Vector3, 3> edges = {corners[1] - corners[0], corners[2] - corners[1],
+                                              corners[0] - corners[2]};
+        add(edges[0].cross(edges[1]), corners, half);
+        for (const Vector3& edge : edges) {
+            for (int axis = 0; axis < 3; ++axis) {
+                // The axis e_axis x edge, written out: its component along `axis` is zero.
+                Vector3 direction = Vector3::Zero();
+                const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+                direction[a1] = -edge[a2];
+                direction[a2] = edge[a1];
+                add(direction, corners, half);
+            }
         }
     }
-    return true;
-}
+
+    /// Whether the triangle overlaps the box of half-size `half` centred at `center`.
+    bool overlaps(const Point3& center) const {
+        for (int k = 0; k < count_; ++k) {
+            const double c = axes_[k].dot(center);
+            if (lo_[k] - c > radius_[k] || c - hi_[k] > radius_[k]) return false;
+        }
+        return true;
+    }
+
+private:
+    void add(const Vector3& axis, const std::array<Vector3, 3>& corners, const Vector3& half) {
+        if (axis == Vector3::Zero()) return;
+        const double p0 = axis.dot(corners[0]), p1 = axis.dot(corners[1]),
+                     p2 = axis.dot(corners[2]);
+        axes_[count_] = axis;
+        lo_[count_] = std::min({p0, p1, p2});
+        hi_[count_] = std::max({p0, p1, p2});
+        radius_[count_] = half.dot(axis.cwiseAbs());
+        ++count_;
+    }
+
+    std::array<Vector3, 10> axes_;
+    std::array<double, 10> lo_, hi_, radius_;
+    int count_ = 0;
+};
 
 template <class Set>
 concept HasTriangleCorners = requires(const Set& set, std::size_t i) {
@@ -103,25 +124,28 @@ void for_each_overlapped_cell(const Set& set, std::uint32_t primitive, const Gri
         hi[axis] = grid.cell_coordinate(grown.upper[axis], axis);
     }
     const bool single_cell = lo == hi;
-    std::array<Vector3, 3> corners;
     if constexpr (HasTriangleCorners<Set>) {
         if (triangle_test && !single_cell) {
+            std::array<Vector3, 3> corners;
             for (int k = 0; k < 3; ++k)
                 corners[k] = set.corner(primitive, k).template cast<double>();
+            const TriangleBoxTest test(corners, 0.5 * grid.cell_size + Vector3::Constant(padding));
+            for (int z = lo[2]; z <= hi[2]; ++z) {
+                for (int y = lo[1]; y <= hi[1]; ++y) {
+                    for (int x = lo[0]; x <= hi[0]; ++x) {
+                        const Point3 center =
+                            grid.bounds.lower + (Vector3(x, y, z) + Vector3::Constant(0.5))
+                                                    .cwiseProduct(grid.cell_size);
+                        if (test.overlaps(center)) visit(grid.cell_index(x, y, z));
+                    }
+                }
+            }
+            return;
         }
     }
     for (int z = lo[2]; z <= hi[2]; ++z) {
         for (int y = lo[1]; y <= hi[1]; ++y) {
-            for (int x = lo[0]; x <= hi[0]; ++x) {
-                if constexpr (HasTriangleCorners<Set>) {
-                    if (triangle_test && !single_cell) {
-                        const Aabb cell = grid.cell_box(x, y, z);
-                        const Vector3 half = 0.5 * cell.diagonal() + Vector3::Constant(padding);
-                        if (!triangle_overlaps_box(corners, cell.center(), half)) continue;
-                    }
-                }
-                visit(grid.cell_index(x, y, z));
-            }
+            for (int x = lo[0]; x <= hi[0]; ++x) visit(grid.cell_index(x, y, z));
         }
     }
 }
@@ -198,8 +222,9 @@ public:
         return true;
     }
 
-private:
     static constexpr std::uint32_t kSlots = 64;
+
+private:
     std::array<std::uint32_t, kSlots> slots_;
 };
 

@@ -24,27 +24,31 @@ constexpr std::size_t kMaxReferenceGrowth = 8;
 /// Whether a cell listing `count` primitives should hold the sub-grid `geometry` (with lists
 /// `offsets`) instead. Three conditions:
 /// - it separates them: no sub-cell lists all of them;
-/// - it does not multiply them: at most kMaxReferenceGrowth references per primitive.
-///   Primitives no sub-grid can separate (identical or nearly so, or all crossing one spot)
-///   would be listed again in every sub-cell and, beyond the mailbox's slots, tested again in
-///   each;
+/// - it does not multiply long lists: more than kMaxReferenceGrowth references per primitive
+///   are accepted only while every sub-cell's list fits the mailbox. Primitives no sub-grid
+///   can separate (identical or nearly so, or all crossing one spot) would be listed again in
+///   every sub-cell and, beyond the mailbox's slots, tested again in each; long thin
+///   primitives legitimately cross many sub-cells, in short lists;
 /// - it is cheaper for a random ray through the cell: the sub-grid's box clip, plus each
 ///   sub-cell's step and list weighted by the chance a ray through the cell crosses that
 ///   sub-cell (the ratio of surface areas, as in the SAH: Goldsmith & Salmon 1987, MacDonald
 ///   & Booth 1990), against testing the whole list.
 bool sub_grid_pays(const detail::GridGeometry& geometry, const std::vector<std::uint32_t>& offsets,
                    std::size_t count, double cell_area) {
-    if (offsets.back() > kMaxReferenceGrowth * count) return false;
     const Vector3 size = geometry.cell_size;
     const double sub_cell_area =
         2.0 * (size.x() * size.y() + size.y() * size.z() + size.z() * size.x());
     const double crossing = sub_cell_area / cell_area;
     double cost = kSubGridCost;
+    std::uint32_t longest = 0;
     for (std::size_t c = 0; c < geometry.cell_count(); ++c) {
         const std::uint32_t listed = offsets[c + 1] - offsets[c];
-        if (listed == count) return false;
+        longest = std::max(longest, listed);
         cost += crossing * (kCellCost + double(listed));
     }
+    if (longest == count) return false;
+    if (offsets.back() > kMaxReferenceGrowth * count && longest > detail::Mailbox::kSlots)
+        return false;
     return cost < double(count);
 }
 
