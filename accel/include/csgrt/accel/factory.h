@@ -6,6 +6,7 @@
 
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/brute_force.h"
+#include "csgrt/accel/bvh.h"
 #include "csgrt/accel/hierarchical_grid.h"
 #include "csgrt/accel/regular_grid.h"
 
@@ -16,6 +17,7 @@ struct AcceleratorConfig {
     BruteForceConfig brute_force;
     GridConfig grid;
     HierarchicalGridConfig hierarchical_grid;
+    BvhConfig bvh;
 };
 
 /// The names `make_accelerator` accepts, in the order the benchmark reports them.
