@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <initializer_list>
 #include <memory>
 #include <thread>
 #include <tuple>
@@ -203,14 +204,16 @@ struct AgreementCounts {
     int all_hits_checked = 0;
 };
 
-/// Checks `structure` against brute force on every ray: the same hit or miss, bit-identical
-/// t, the same member, primitive and barycentrics (the tie rule of PrimitiveSet makes the
-/// nearest hit unique), occluded == intersect for both entry points, and (every
-/// `all_hits_every`th ray) the same all_hits as a set with no member twice. Stops after a
-/// few failures so a broken structure does not flood the log.
+/// Checks each of `structures` against brute force on every ray: the same hit or miss,
+/// bit-identical t, the same member, primitive and barycentrics (the tie rule of PrimitiveSet
+/// makes the nearest hit unique), occluded == intersect for both entry points, and (every
+/// `all_hits_every`th ray) the same all_hits as a set with no member twice. Brute force
+/// answers each ray once for all structures. Stops after a few failures so a broken
+/// structure does not flood the log.
 template <class Set>
-AgreementCounts expect_agreement(const Accelerator<Set>& structure, const BruteForce<Set>& brute,
-                                 const std::vector<Ray>& rays, int all_hits_every = 8) {
+AgreementCounts expect_agreement(std::initializer_list<const Accelerator<Set>*> structures,
+                                 const BruteForce<Set>& brute, const std::vector<Ray>& rays,
+                                 int all_hits_every = 8) {
     AgreementCounts counts;
     QueryScratch scratch;
     int failures = 0;
@@ -218,45 +221,60 @@ AgreementCounts expect_agreement(const Accelerator<Set>& structure, const BruteF
     for (std::size_t i = 0; i < rays.size() && failures < 5; ++i) {
         const Ray& ray = rays[i];
         ++counts.rays;
-        HitRecord expected, actual;
+        HitRecord expected;
         const bool expected_hit = brute.intersect(ray, expected, scratch);
-        const bool actual_hit = structure.intersect(ray, actual, scratch);
         counts.hits += expected_hit;
-        bool ok = expected_hit == actual_hit;
-        if (ok && expected_hit) {
-            ok = expected.t == actual.t && member_of<Set>(expected) == member_of<Set>(actual) &&
-                 expected.primitive == actual.primitive && expected.u == actual.u &&
-                 expected.v == actual.v && expected.shape == actual.shape;
-        }
-        TraversalCounters counters;
-        ok = ok && structure.occluded(ray, scratch) == expected_hit &&
-             structure.occluded_counted(ray, scratch, counters) == expected_hit;
-        HitRecord counted;
-        ok = ok && structure.intersect_counted(ray, counted, scratch, counters) == expected_hit &&
-             (!expected_hit || counted.t == expected.t);
-        if (!ok) {
-            ++failures;
-            ADD_FAILURE() << "ray " << i << " origin (" << ray.origin.transpose() << ") direction ("
-                          << ray.direction.transpose() << ") [" << ray.t_min << ", " << ray.t_max
-                          << "]: brute " << expected_hit << " t " << expected.t << " member "
-                          << member_of<Set>(expected) << ", " << structure.name() << " "
-                          << actual_hit << " t " << actual.t << " member "
-                          << member_of<Set>(actual);
-        }
-        if (all_hits_every > 0 && i % std::size_t(all_hits_every) == 0) {
+        const bool check_all = all_hits_every > 0 && i % std::size_t(all_hits_every) == 0;
+        if (check_all) {
             expected_all.clear();
-            actual_all.clear();
             brute.all_hits(ray, expected_all, scratch);
-            structure.all_hits(ray, actual_all, scratch);
             ++counts.all_hits_checked;
-            if (hit_set<Set>(expected_all) != hit_set<Set>(actual_all)) {
+        }
+        for (const Accelerator<Set>* structure : structures) {
+            HitRecord actual;
+            const bool actual_hit = structure->intersect(ray, actual, scratch);
+            bool ok = expected_hit == actual_hit;
+            if (ok && expected_hit) {
+                ok = expected.t == actual.t && member_of<Set>(expected) == member_of<Set>(actual) &&
+                     expected.primitive == actual.primitive && expected.u == actual.u &&
+                     expected.v == actual.v && expected.shape == actual.shape;
+            }
+            TraversalCounters counters;
+            ok = ok && structure->occluded(ray, scratch) == expected_hit &&
+                 structure->occluded_counted(ray, scratch, counters) == expected_hit;
+            HitRecord counted;
+            ok = ok &&
+                 structure->intersect_counted(ray, counted, scratch, counters) == expected_hit &&
+                 (!expected_hit || counted.t == expected.t);
+            if (!ok) {
                 ++failures;
-                ADD_FAILURE() << "all_hits differ on ray " << i << ": brute " << expected_all.size()
-                              << " hits, " << structure.name() << " " << actual_all.size();
+                ADD_FAILURE() << "ray " << i << " origin (" << ray.origin.transpose()
+                              << ") direction (" << ray.direction.transpose() << ") [" << ray.t_min
+                              << ", " << ray.t_max << "]: brute " << expected_hit << " t "
+                              << expected.t << " member " << member_of<Set>(expected) << ", "
+                              << structure->name() << " " << actual_hit << " t " << actual.t
+                              << " member " << member_of<Set>(actual);
+            }
+            if (check_all) {
+                actual_all.clear();
+                structure->all_hits(ray, actual_all, scratch);
+                if (hit_set<Set>(expected_all) != hit_set<Set>(actual_all)) {
+                    ++failures;
+                    ADD_FAILURE() << "all_hits differ on ray " << i << ": brute "
+                                  << expected_all.size() << " hits, " << structure->name() << " "
+                                  << actual_all.size();
+                }
             }
         }
     }
     return counts;
+}
+
+/// expect_agreement for one structure.
+template <class Set>
+AgreementCounts expect_agreement(const Accelerator<Set>& structure, const BruteForce<Set>& brute,
+                                 const std::vector<Ray>& rays, int all_hits_every = 8) {
+    return expect_agreement({&structure}, brute, rays, all_hits_every);
 }
 
 /// Answers `rays` from `threads` threads at once (each a strided share, each with its own

@@ -50,37 +50,7 @@ protected:
 using Precisions = ::testing::Types<float, double>;
 TYPED_TEST_SUITE(HierarchicalGridTest, Precisions);
 
-// Together these check about 120,000 rays per precision against brute force.
-TYPED_TEST(HierarchicalGridTest, AgreesWithBruteForceOnIntegerCube) {
-    EXPECT_EQ(this->expect_agreement_on(test::integer_cube(8), 18000, 18000, 201), 37800);
-}
-
-TYPED_TEST(HierarchicalGridTest, AgreesWithBruteForceOnSphereMeshes) {
-    EXPECT_EQ(this->expect_agreement_on(test::sphere_mesh(5), 6000, 6000, 202), 12600);
-    EXPECT_EQ(this->expect_agreement_on(test::sphere_mesh(6), 1500, 1500, 203), 3150);
-}
-
-TYPED_TEST(HierarchicalGridTest, AgreesWithBruteForceOnLongThinTriangles) {
-    const TestMesh soup = test::long_thin_soup(2000, 7);
-    EXPECT_EQ(this->expect_agreement_on(soup, 12000, 12000, 204), 25200);
-    EXPECT_EQ(this->expect_agreement_on(soup, 2000, 2000, 205,
-                                        HierarchicalGridConfig{.triangle_box_test = false}),
-              4200);
-}
-
-TYPED_TEST(HierarchicalGridTest, AgreesWithBruteForceInTeapotInStadium) {
-    EXPECT_EQ(this->expect_agreement_on(test::teapot_in_stadium(), 10000, 10000, 206), 21000);
-}
-
-TYPED_TEST(HierarchicalGridTest, AgreesWithBruteForceFarFromTheOrigin) {
-    // As for the regular grid: float rounding near coordinates of 1000 must stay inside the
-    // padding at every level.
-    TestMesh far;
-    test::append(far, test::sphere_mesh(4), 1.0, Vector3(1000.3, -1000.7, 999.1));
-    test::append(far, test::long_thin_soup(300, 5), 0.2, Vector3(999.0, -1001.0, 998.0));
-    EXPECT_EQ(this->expect_agreement_on(far, 8000, 8000, 207), 16800);
-}
-
+// The agreement on in-code meshes at the default settings is in grid_agreement_test.cpp.
 TYPED_TEST(HierarchicalGridTest, AgreesWithBruteForceUnderOtherSettings) {
     // No nesting (a plain coarse grid), deep nesting with small cells, one cell on top, and
     // sub-grids forced wherever a cell holds more than one primitive.
@@ -293,21 +263,6 @@ TEST(HierarchicalGrid, FindsFloatHitsJustOutsideATriangleAndStopsWellPastTheBest
     BruteForce<TriangleSet<float>> brute;
     brute.build(set);
     test::expect_agreement(hgrid, brute, test::rays_through_twins(20000, 219, 3e5), 16);
-}
-
-TEST(HierarchicalGrid, AgreesWithBruteForceOnTenThousandSpheres) {
-    const ShapeSet set(test::random_spheres(10000, 220));
-    HierarchicalGrid<ShapeSet> hgrid;
-    hgrid.build(set);
-    BruteForce<ShapeSet> brute;
-    brute.build(set);
-    const Aabb box(Point3(0, 0, 0), Point3(10, 10, 10));
-    std::vector<Ray> rays = test::camera_rays(box, 5000, 221);
-    const std::vector<Ray> more = test::incoherent_rays(box, 5000, 222);
-    rays.insert(rays.end(), more.begin(), more.end());
-    const test::AgreementCounts counts = test::expect_agreement(hgrid, brute, rays, 10);
-    EXPECT_GT(counts.hits, counts.rays / 4);
-    test::expect_same_answers_concurrently(hgrid, rays, 3);
 }
 
 TEST(HierarchicalGrid, EveryPointOfAPrimitiveFindsItInItsInnermostCell) {

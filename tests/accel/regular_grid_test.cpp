@@ -39,41 +39,7 @@ protected:
 using Precisions = ::testing::Types<float, double>;
 TYPED_TEST_SUITE(RegularGridTest, Precisions);
 
-// Together these check about 120,000 rays per precision against brute force.
-TYPED_TEST(RegularGridTest, AgreesWithBruteForceOnIntegerCube) {
-    // Vertices, edges and faces on integer planes: rays meet shared edges and vertices.
-    EXPECT_EQ(this->expect_agreement_on(test::integer_cube(8), 18000, 18000, 101), 37800);
-}
-
-TYPED_TEST(RegularGridTest, AgreesWithBruteForceOnSphereMeshes) {
-    EXPECT_EQ(this->expect_agreement_on(test::sphere_mesh(5), 6000, 6000, 102), 12600);
-    EXPECT_EQ(this->expect_agreement_on(test::sphere_mesh(6), 1500, 1500, 103), 3150);
-}
-
-TYPED_TEST(RegularGridTest, AgreesWithBruteForceOnLongThinTriangles) {
-    // With and without the triangle-box test: both must find exactly what brute force finds.
-    const TestMesh soup = test::long_thin_soup(2000, 7);
-    EXPECT_EQ(this->expect_agreement_on(soup, 12000, 12000, 104), 25200);
-    EXPECT_EQ(
-        this->expect_agreement_on(soup, 2000, 2000, 105, GridConfig{.triangle_box_test = false}),
-        4200);
-}
-
-TYPED_TEST(RegularGridTest, AgreesWithBruteForceInTeapotInStadium) {
-    EXPECT_EQ(this->expect_agreement_on(test::teapot_in_stadium(), 10000, 10000, 106), 21000);
-}
-
-TYPED_TEST(RegularGridTest, AgreesWithBruteForceFarFromTheOrigin) {
-    // A mesh of unit size at coordinates near 1000: float rounds the ray origin by up to
-    // 3e-5 there, so the float test answers for a slightly shifted ray and may report hits
-    // just outside a triangle's box. The cells' padding (relative to the coordinates) must
-    // cover that, or a hit brute force finds lies in a cell that does not list its triangle.
-    TestMesh far;
-    test::append(far, test::sphere_mesh(4), 1.0, Vector3(1000.3, -1000.7, 999.1));
-    test::append(far, test::long_thin_soup(300, 5), 0.2, Vector3(999.0, -1001.0, 998.0));
-    EXPECT_EQ(this->expect_agreement_on(far, 8000, 8000, 111), 16800);
-}
-
+// The agreement on in-code meshes at the default settings is in grid_agreement_test.cpp.
 TYPED_TEST(RegularGridTest, AgreesWithBruteForceAtOtherResolutions) {
     // Very coarse (one cell), very fine, and a clamp of 3 cells per axis.
     const TestMesh sphere = test::sphere_mesh(3);
@@ -340,21 +306,6 @@ TEST(RegularGrid, StopsOnlyWellPastTheBestHitForRaysFromFarAway) {
     }
     EXPECT_GT(far_wins, 0);
     EXPECT_GT(near_wins, 0);
-}
-
-TEST(RegularGrid, AgreesWithBruteForceOnTenThousandSpheres) {
-    const ShapeSet set(test::random_spheres(10000, 16));
-    RegularGrid<ShapeSet> grid;
-    grid.build(set);
-    BruteForce<ShapeSet> brute;
-    brute.build(set);
-    const Aabb box(Point3(0, 0, 0), Point3(10, 10, 10));
-    std::vector<Ray> rays = test::camera_rays(box, 5000, 17);
-    const std::vector<Ray> more = test::incoherent_rays(box, 5000, 18);
-    rays.insert(rays.end(), more.begin(), more.end());
-    const test::AgreementCounts counts = test::expect_agreement(grid, brute, rays, 10);
-    EXPECT_GT(counts.hits, counts.rays / 4);
-    test::expect_same_answers_concurrently(grid, rays, 3);
 }
 
 TEST(RegularGrid, UnboundedShapesAreTestedByEveryRay) {
