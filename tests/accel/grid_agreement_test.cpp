@@ -34,7 +34,8 @@ protected:
         const std::vector<Ray> axes = test::axis_rays(box, incoherent / 10, seed + 2);
         rays.insert(rays.end(), more.begin(), more.end());
         rays.insert(rays.end(), axes.begin(), axes.end());
-        const test::AgreementCounts counts = test::expect_agreement({&grid, &hgrid}, brute, rays);
+        const test::AgreementCounts counts =
+            test::expect_agreement({&grid, &hgrid}, brute, rays, 16);
         // Every mesh here is hit by a good share of these rays; a structure that missed
         // everything would agree with nothing.
         EXPECT_GT(counts.hits, counts.rays / 5)
@@ -48,19 +49,20 @@ TYPED_TEST_SUITE(GridAgreementTest, Precisions);
 // Together these check 112,350 rays per precision against brute force, for each grid.
 TYPED_TEST(GridAgreementTest, IntegerCube) {
     // Vertices, edges and faces on integer planes: rays meet shared edges and vertices.
-    EXPECT_EQ(this->expect_agreement_on(test::integer_cube(8), 18000, 18000, 101), 37800);
+    EXPECT_EQ(this->expect_agreement_on(test::integer_cube(8), 24500, 24500, 101), 51450);
 }
 
-TYPED_TEST(GridAgreementTest, SphereMeshes) {
-    // 8,192 and 32,768 triangles: each brute-force answer is costly, so fewer rays here.
+TYPED_TEST(GridAgreementTest, SphereMesh) {
+    // 8,192 triangles: each brute-force answer is costly, so fewer rays here (the real meshes
+    // of grid_reference_test.cpp, up to 52,000 triangles, are compared with brute force on a
+    // sample of rays).
     EXPECT_EQ(this->expect_agreement_on(test::sphere_mesh(5), 3000, 3000, 102), 6300);
-    EXPECT_EQ(this->expect_agreement_on(test::sphere_mesh(6), 500, 500, 103), 1050);
 }
 
 TYPED_TEST(GridAgreementTest, LongThinTriangles) {
     // With and without the triangle-box test: both must find exactly what brute force finds.
     const TestMesh soup = test::long_thin_soup(2000, 7);
-    EXPECT_EQ(this->expect_agreement_on(soup, 12000, 12000, 104), 25200);
+    EXPECT_EQ(this->expect_agreement_on(soup, 6000, 6000, 104), 12600);
     EXPECT_EQ(
         this->expect_agreement_on(soup, 2000, 2000, 105, GridConfig{.triangle_box_test = false},
                                   HierarchicalGridConfig{.triangle_box_test = false}),
@@ -92,8 +94,8 @@ TEST(GridAgreement, TenThousandSpheres) {
     BruteForce<ShapeSet> brute;
     brute.build(set);
     const Aabb box(Point3(0, 0, 0), Point3(10, 10, 10));
-    std::vector<Ray> rays = test::camera_rays(box, 5000, 17);
-    const std::vector<Ray> more = test::incoherent_rays(box, 5000, 18);
+    std::vector<Ray> rays = test::camera_rays(box, 2000, 17);
+    const std::vector<Ray> more = test::incoherent_rays(box, 2000, 18);
     rays.insert(rays.end(), more.begin(), more.end());
     const test::AgreementCounts counts = test::expect_agreement({&grid, &hgrid}, brute, rays, 10);
     EXPECT_GT(counts.hits, counts.rays / 4);
