@@ -6,12 +6,14 @@
 
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/brute_force.h"
+#include "csgrt/accel/ray_classification.h"
 
 namespace csgrt {
 
 /// The configuration of every structure, so one value can be handed to the factory.
 struct AcceleratorConfig {
     BruteForceConfig brute_force;
+    RayClassificationConfig ray_classification;
 };
 
 /// The names `make_accelerator` accepts, in the order the benchmark reports them.

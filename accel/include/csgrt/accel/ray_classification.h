@@ -1,0 +1,211 @@
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "csgrt/accel/accelerator.h"
+#include "csgrt/core/aabb.h"
+
+namespace csgrt {
+
+/// How a ray-space cell picks the axis it is halved along.
+enum class RayClassificationSplit {
+    /// x, y, z, u, v in turn, by depth (Arvo & Kirk's order).
+    kCycle,
+    /// The axis along which the cell's beam is widest: an origin axis by its extent, a
+    /// direction axis by its extent times the scene's depth along the face's axis (how far the
+    /// beam fans out across the scene). The dominant origin axis is never chosen (see
+    /// docs/structures.md).
+    kWidestBeam,
+};
+
+struct RayClassificationConfig {
+    /// A leaf that a ray reaches is split while it holds more candidates than this.
+    std::uint32_t max_leaf_candidates = 8;
+    /// The deepest a face's tree may grow (halvings from its root), at most 60.
+    int max_depth = 40;
+    /// Cap on the bytes of all candidate lists, the six root lists included. Once a split
+    /// would exceed it, the leaf stays a leaf and keeps its (longer) list; stats() reports how
+    /// often that happened. Answers stay exact whatever the cap (0: the six sorted root lists
+    /// only).
+    std::size_t max_candidate_bytes = std::size_t{1} << 30;
+    RayClassificationSplit split = RayClassificationSplit::kWidestBeam;
+    /// Subdivide every cell with more than max_leaf_candidates candidates down to this depth
+    /// during build(), before any ray arrives (0: purely lazy).
+    int build_depth = 0;
+};
+
+namespace detail {
+
+/// The face of the direction cube a direction points through, and its coordinates on it: the
+/// dominant axis a = argmax |d_i| (ties go to the lower axis), the sign of d_a, and
+/// u = d_b / |d_a|, v = d_c / |d_a| in [-1, 1], with b = a+1, c = a+2 (mod 3).
+struct DirectionFace {
+    int axis;
+    bool negative;
+    double u, v;
+};
+/// Assumes a non-zero direction.
+DirectionFace direction_face(const Vector3& direction);
+
+/// One hypercube of 5D ray space: rays from a point of `origin` with direction
+/// (±e_a + u e_b + v e_c) on the face (axis, negative), (u, v) in the given rectangle.
+struct RayCell {
+    int axis = 0;
+    bool negative = false;
+    Aabb origin;
+    double u_lower = -1.0, u_upper = 1.0;
+    double v_lower = -1.0, v_upper = 1.0;
+};
+
+/// Conservative beam test: false only when no ray of `cell` meets `box` at a parameter
+/// t >= 0. The beam {o + t dir} is the Minkowski sum of the origin box and the cone of
+/// directions, a convex set; the test checks its projections: the t range in which a ray can
+/// be inside the box's slab along the face axis, then the spread of the other two coordinates
+/// over that t range (Arvo & Kirk, "Fast Ray Tracing by Ray Classification", SIGGRAPH 1987).
+/// Exact arithmetic would make it conservative; in double it may miss a box by a few ulps of
+/// the coordinates, which the structure's box padding covers.
+inline bool beam_may_hit(const RayCell& cell, const Aabb& box) {
+    const int a = cell.axis, b = (a + 1) % 3, c = (a + 2) % 3;
+    // Along the face axis a ray advances by exactly t (its direction is ±e_a + ...), so the
+    // parameters at which some ray of the cell is inside the box's slab form this interval.
+    double t_lower, t_upper;
+    if (cell.negative) {
+        t_lower = cell.origin.lower[a] - box.upper[a];
+        t_upper = cell.origin.upper[a] - box.lower[a];
+    } else {
+        t_lower = box.lower[a] - cell.origin.upper[a];
+        t_upper = box.upper[a] - cell.origin.lower[a];
+    }
+    t_lower = std::max(t_lower, 0.0);
+    if (!(t_lower <= t_upper)) return false;
+    // Over that t range the other coordinates are o_k + t w, w in [w_lower, w_upper]: the
+    // product is bilinear, so its extremes are at the corners, and t >= 0 picks which.
+    auto spread_meets = [&](int k, double w_lower, double w_upper) {
+        const double low = cell.origin.lower[k] + std::min(t_lower * w_lower, t_upper * w_lower);
+        const double high = cell.origin.upper[k] + std::max(t_lower * w_upper, t_upper * w_upper);
+        return low <= box.upper[k] && high >= box.lower[k];
+    };
+    return spread_meets(b, cell.u_lower, cell.u_upper) &&
+           spread_meets(c, cell.v_lower, cell.v_upper);
+}
+
+}  // namespace detail
+
+/// Ray classification (Arvo & Kirk, "Fast Ray Tracing by Ray Classification", SIGGRAPH 1987):
+/// a ray is a point of 5D ray space (where it enters the scene box, and its direction as a
+/// point of one face of the direction cube), six binary trees of hypercubes cover that space,
+/// and each hypercube keeps the candidates its beam can meet, sorted by where they begin along
+/// the face's axis so a search stops at the first candidate beyond the best hit. Hypercubes
+/// are split lazily, when rays reach them; lazy splitting is thread-safe, and once a path is
+/// built queries take no lock (docs/structures.md).
+template <class Set>
+class RayClassification final : public Accelerator<Set> {
+public:
+    RayClassification();
+    ~RayClassification() override;
+    RayClassification(const RayClassification&) = delete;
+    RayClassification& operator=(const RayClassification&) = delete;
+
+    /// Pads and sorts the primitives into the six root cells, then subdivides to
+    /// config.build_depth. Throws InvalidParameter for a bad configuration.
+    void build(const Set& set, const RayClassificationConfig& config = {});
+    /// Classifies `rays` as queries would, splitting every cell they reach, so a benchmark
+    /// can time the lazy build apart from the queries. Safe alongside queries.
+    void prebuild(std::span<const Ray> rays);
+
+    std::string_view name() const override { return "rayclass"; }
+    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
+    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
+    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                           TraversalCounters& counters) const override;
+    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
+                          TraversalCounters& counters) const override;
+    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
+                  QueryScratch& scratch) const override;
+    /// The current figures: they grow as rays split cells.
+    AcceleratorStats stats() const override;
+
+    /// Bytes of all candidate lists now held (never above the cap, unless the six root lists
+    /// alone are).
+    std::size_t candidate_bytes() const { return candidate_bytes_.load(std::memory_order_relaxed); }
+    /// Splits refused because they would have exceeded max_candidate_bytes.
+    std::size_t splits_refused() const { return splits_refused_.load(std::memory_order_relaxed); }
+    /// The half-width added to every primitive box, in scene units.
+    double box_padding() const { return padding_; }
+
+private:
+    /// A primitive in a cell's list, with where its padded box begins along the face's axis
+    /// (in the coordinate that grows along the rays, rounded down to float).
+    struct Candidate {
+        float key;
+        std::uint32_t index;
+    };
+    struct Node;
+    /// The candidates one ray must test: a leaf's list (sorted, so the search may stop early)
+    /// or, for a ray too far from the scene for the padding to cover its rounding, a whole
+    /// root list.
+    struct Search {
+        const Candidate* candidates = nullptr;
+        std::uint32_t count = 0;
+        bool stops_early = false;
+        /// The ray's coordinate along the face axis is w_origin + t * w_speed.
+        double w_origin = 0.0;
+        double w_speed = 0.0;
+    };
+
+    Search find_candidates(const Ray& ray, TraversalCounters& counters) const;
+    /// The leaf of tree `face` holding the ray-space point `coordinates` (x, y, z, u, v),
+    /// splitting the cells on the way that are still too long.
+    const Node* locate(int face, const double coordinates[5], TraversalCounters& counters) const;
+    void split(Node& node, int face, int depth, const double lower[5], const double upper[5]) const;
+    void subdivide(Node& node, int face, int depth, double lower[5], double upper[5]);
+    int split_axis(int face, int depth, const double lower[5], const double upper[5]) const;
+    void root_cell(double lower[5], double upper[5]) const;
+    template <bool kCount>
+    bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                        TraversalCounters& counters) const;
+    template <bool kCount>
+    bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+
+    const Set* set_ = nullptr;
+    RayClassificationConfig config_;
+    /// Padded boxes of the bounded primitives (indexed by primitive).
+    std::vector<Aabb> boxes_;
+    /// Primitives without a finite box (unbounded shapes): every ray tests them.
+    std::vector<std::uint32_t> unbounded_;
+    /// The union of the padded boxes, padded once more: the origin range of every root.
+    Aabb scene_;
+    double padding_ = 0.0;
+    /// How far a hit reported by the set may lie outside its primitive's exact box, relative
+    /// to |origin|_inf + the scene's largest coordinate.
+    double hit_error_ = 0.0;
+    double largest_coordinate_ = 0.0;
+    std::unique_ptr<Node[]> roots_;
+    /// Lazy splits lock one of these, chosen by the node's address.
+    mutable std::array<std::mutex, 64> split_locks_;
+    mutable std::atomic<std::size_t> candidate_bytes_{0};
+    mutable std::atomic<std::size_t> references_{0};
+    mutable std::atomic<std::size_t> nodes_{0};
+    mutable std::atomic<std::size_t> splits_refused_{0};
+    mutable std::atomic<std::int64_t> lazy_nanoseconds_{0};
+    mutable std::atomic<int> deepest_{0};
+    double build_milliseconds_ = 0.0;
+};
+
+class ShapeSet;
+template <class Real>
+class TriangleSet;
+extern template class RayClassification<TriangleSet<float>>;
+extern template class RayClassification<TriangleSet<double>>;
+extern template class RayClassification<ShapeSet>;
+
+}  // namespace csgrt

@@ -1,0 +1,532 @@
+#include "csgrt/accel/ray_classification.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include "csgrt/accel/shape_set.h"
+#include "csgrt/accel/triangle_set.h"
+#include "csgrt/core/error.h"
+
+namespace csgrt {
+
+namespace detail {
+
+DirectionFace direction_face(const Vector3& direction) {
+    const int axis = max_dimension(direction);
+    const double length = std::abs(direction[axis]);
+    // Division (not a product with 1/length) keeps |u|, |v| <= 1 exactly: a correctly rounded
+    // quotient of |x| <= |y| never exceeds 1.
+    return {axis, direction[axis] < 0.0, direction[(axis + 1) % 3] / length,
+            direction[(axis + 2) % 3] / length};
+}
+
+}  // namespace detail
+
+namespace {
+
+/// How far a hit the set reports may lie outside its primitive's exact box, as a fraction of
+/// |origin|_inf + the scene's largest coordinate. Woop's float test rounds the origin, the
+/// translated corners, the shear and the edge functions: about 10 units of 2^-24 of those
+/// magnitudes in all (Woop, Benthin, Wald 2013, section 4); 64 leaves a wide margin. Shapes
+/// solve their roots in double, the quartic ones iteratively: 2^-30 trusts them to 1e-9.
+template <class Set>
+constexpr double kHitError = 0x1p-30;
+template <>
+constexpr double kHitError<TriangleSet<float>> = 64 * 0x1p-24;
+template <>
+constexpr double kHitError<TriangleSet<double>> = 64 * 0x1p-53;
+
+/// The largest float not above `value`: candidate keys may only err toward the ray's start.
+float round_down(double value) {
+    if (value >= double(std::numeric_limits<float>::max()))
+        return std::numeric_limits<float>::max();
+    if (!(value >= -double(std::numeric_limits<float>::max()))) return -kInfinity;
+    float rounded = static_cast<float>(value);
+    if (double(rounded) > value)
+        rounded = std::nextafter(rounded, -std::numeric_limits<float>::infinity());
+    return rounded;
+}
+
+constexpr int kDirectionU = 3;
+constexpr int kDirectionV = 4;
+
+}  // namespace
+
+template <class Set>
+struct RayClassification<Set>::Node {
+    /// Two children, published with release once they are complete; null for a leaf.
+    std::atomic<Node*> children{nullptr};
+    std::unique_ptr<Candidate[]> candidates;
+    std::uint32_t count = 0;
+    /// The axis (x, y, z, u, v) the cell was halved along; written before `children`.
+    std::uint8_t axis = 0;
+    /// Set when a split was refused (memory cap): the leaf is final.
+    std::atomic<bool> closed{false};
+
+    ~Node() { delete[] children.load(std::memory_order_relaxed); }
+};
+
+template <class Set>
+RayClassification<Set>::RayClassification() = default;
+
+template <class Set>
+RayClassification<Set>::~RayClassification() = default;
+
+template <class Set>
+void RayClassification<Set>::build(const Set& set, const RayClassificationConfig& config) {
+    const char* what = "RayClassification";
+    require(config.max_leaf_candidates >= 1, what, "max_leaf_candidates", ">= 1",
+            config.max_leaf_candidates);
+    require(config.max_depth >= 0 && config.max_depth <= 60, what, "max_depth", "in [0, 60]",
+            config.max_depth);
+    require(config.build_depth >= 0 && config.build_depth <= 60, what, "build_depth", "in [0, 60]",
+            config.build_depth);
+    const auto start = std::chrono::steady_clock::now();
+    set_ = &set;
+    config_ = config;
+    roots_.reset();
+    candidate_bytes_ = references_ = nodes_ = splits_refused_ = 0;
+    lazy_nanoseconds_ = 0;
+    deepest_ = 0;
+    hit_error_ = kHitError<Set>;
+
+    const std::size_t count = set.size();
+    boxes_.assign(count, Aabb{});
+    unbounded_.clear();
+    std::vector<std::uint32_t> bounded;
+    Aabb bounds;
+    for (std::size_t i = 0; i < count; ++i) {
+        const Aabb box = set.bounds(i);
+        if (box.is_finite() && !box.is_empty()) {
+            boxes_[i] = box;
+            bounds.extend(box);
+            bounded.push_back(static_cast<std::uint32_t>(i));
+        } else {
+            unbounded_.push_back(static_cast<std::uint32_t>(i));
+        }
+    }
+    largest_coordinate_ = 0.0;
+    padding_ = 0.0;
+    if (!bounded.empty()) {
+        const double largest =
+            std::max(bounds.lower.cwiseAbs().maxCoeff(), bounds.upper.cwiseAbs().maxCoeff());
+        const double diagonal = bounds.diagonal().norm();
+        // Twice the hit error of a ray from up to 16 scene diagonals away (the rest of the
+        // classification rounds in double, far below this), and at least 2^-20 of the scene
+        // so rays of double-precision sets may come from much farther.
+        padding_ = std::max(2.0 * hit_error_ * (2.0 * largest + 16.0 * diagonal),
+                            0x1p-20 * (largest + diagonal));
+        padding_ = std::max(padding_, std::numeric_limits<double>::min());
+        largest_coordinate_ = largest;
+        if (!(largest + diagonal + 4.0 * padding_ < 1e300)) {
+            // Coordinates this large leave no room to pad: every ray tests everything.
+            unbounded_.insert(unbounded_.end(), bounded.begin(), bounded.end());
+            std::sort(unbounded_.begin(), unbounded_.end());
+            bounded.clear();
+        }
+    }
+    if (!bounded.empty()) {
+        const Vector3 pad = Vector3::Constant(padding_);
+        for (std::uint32_t i : bounded) {
+            boxes_[i].lower -= pad;
+            boxes_[i].upper += pad;
+        }
+        scene_ = Aabb(bounds.lower - 2.0 * pad, bounds.upper + 2.0 * pad);
+        roots_ = std::make_unique<Node[]>(6);
+        for (int face = 0; face < 6; ++face) {
+            Node& root = roots_[face];
+            const int axis = face / 2;
+            const bool negative = face % 2 == 1;
+            root.count = static_cast<std::uint32_t>(bounded.size());
+            root.candidates = std::make_unique<Candidate[]>(bounded.size());
+            for (std::size_t k = 0; k < bounded.size(); ++k) {
+                const Aabb& box = boxes_[bounded[k]];
+                // The coordinate that grows along the face's rays: x_a, or -x_a on a negative
+                // face; a box begins where that coordinate is smallest.
+                const double begin = negative ? -box.upper[axis] : box.lower[axis];
+                root.candidates[k] = Candidate{round_down(begin), bounded[k]};
+            }
+            std::sort(root.candidates.get(), root.candidates.get() + root.count,
+                      [](const Candidate& x, const Candidate& y) {
+                          return x.key < y.key || (x.key == y.key && x.index < y.index);
+                      });
+        }
+        nodes_ = 6;
+        references_ = 6 * bounded.size();
+        candidate_bytes_ = 6 * bounded.size() * sizeof(Candidate);
+        for (int face = 0; face < 6 && config.build_depth > 0; ++face) {
+            double lower[5], upper[5];
+            root_cell(lower, upper);
+            subdivide(roots_[face], face, 0, lower, upper);
+        }
+    }
+    build_milliseconds_ =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+template <class Set>
+void RayClassification<Set>::root_cell(double lower[5], double upper[5]) const {
+    for (int k = 0; k < 3; ++k) {
+        lower[k] = scene_.lower[k];
+        upper[k] = scene_.upper[k];
+    }
+    lower[kDirectionU] = lower[kDirectionV] = -1.0;
+    upper[kDirectionU] = upper[kDirectionV] = 1.0;
+}
+
+template <class Set>
+void RayClassification<Set>::subdivide(Node& node, int face, int depth, double lower[5],
+                                       double upper[5]) {
+    if (node.count <= config_.max_leaf_candidates || depth >= config_.max_depth ||
+        depth >= config_.build_depth)
+        return;
+    split(node, face, depth, lower, upper);
+    Node* children = node.children.load(std::memory_order_acquire);
+    if (children == nullptr) return;
+    const int axis = node.axis;
+    const double middle = 0.5 * lower[axis] + 0.5 * upper[axis];
+    const double saved_lower = lower[axis], saved_upper = upper[axis];
+    upper[axis] = middle;
+    subdivide(children[0], face, depth + 1, lower, upper);
+    upper[axis] = saved_upper;
+    lower[axis] = middle;
+    subdivide(children[1], face, depth + 1, lower, upper);
+    lower[axis] = saved_lower;
+}
+
+template <class Set>
+int RayClassification<Set>::split_axis(int face, int depth, const double lower[5],
+                                       const double upper[5]) const {
+    if (config_.split == RayClassificationSplit::kCycle) return depth % 5;
+    const int a = face / 2, b = (a + 1) % 3, c = (a + 2) % 3;
+    const bool negative = face % 2 == 1;
+    // The beam's width across the rays, along b and c: the origin extent, plus the origin
+    // extent along a seen obliquely (rays leave at slope up to |u| or |v|), plus the fan of
+    // directions over the distance the rays can still travel through the scene.
+    const double reach = negative ? upper[a] - scene_.lower[a] : scene_.upper[a] - lower[a];
+    const double extent_a = upper[a] - lower[a];
+    const double slope_u = std::max(std::abs(lower[kDirectionU]), std::abs(upper[kDirectionU]));
+    const double slope_v = std::max(std::abs(lower[kDirectionV]), std::abs(upper[kDirectionV]));
+    const double fan_u = (upper[kDirectionU] - lower[kDirectionU]) * reach;
+    const double fan_v = (upper[kDirectionV] - lower[kDirectionV]) * reach;
+    const double width_b = upper[b] - lower[b] + extent_a * slope_u + fan_u;
+    const double width_c = upper[c] - lower[c] + extent_a * slope_v + fan_v;
+    // Halving an axis removes half its term; pick the axis that shrinks the beam's cross
+    // section (width_b * width_c) by the largest factor.
+    const double inverse_b = width_b > 0.0 ? 1.0 / width_b : 0.0;
+    const double inverse_c = width_c > 0.0 ? 1.0 / width_c : 0.0;
+    double gains[5];
+    gains[a] = extent_a * (slope_u * inverse_b + slope_v * inverse_c);
+    gains[b] = (upper[b] - lower[b]) * inverse_b;
+    gains[c] = (upper[c] - lower[c]) * inverse_c;
+    gains[kDirectionU] = fan_u * inverse_b;
+    gains[kDirectionV] = fan_v * inverse_c;
+    return static_cast<int>(std::max_element(gains, gains + 5) - gains);
+}
+
+template <class Set>
+void RayClassification<Set>::split(Node& node, int face, int depth, const double lower[5],
+                                   const double upper[5]) const {
+    const auto start = std::chrono::steady_clock::now();
+    const auto stripe =
+        (reinterpret_cast<std::uintptr_t>(&node) / sizeof(Node)) % split_locks_.size();
+    std::lock_guard<std::mutex> lock(split_locks_[stripe]);
+    if (node.children.load(std::memory_order_relaxed) != nullptr ||
+        node.closed.load(std::memory_order_relaxed))
+        return;
+    auto refuse = [&] {
+        node.closed.store(true, std::memory_order_relaxed);
+        splits_refused_.fetch_add(1, std::memory_order_relaxed);
+    };
+    if (candidate_bytes_.load(std::memory_order_relaxed) >= config_.max_candidate_bytes)
+        return refuse();
+
+    const int axis = split_axis(face, depth, lower, upper);
+    const double middle = 0.5 * lower[axis] + 0.5 * upper[axis];
+    detail::RayCell cells[2];
+    for (int side = 0; side < 2; ++side) {
+        double cell_lower[5], cell_upper[5];
+        std::copy(lower, lower + 5, cell_lower);
+        std::copy(upper, upper + 5, cell_upper);
+        (side == 0 ? cell_upper : cell_lower)[axis] = middle;
+        detail::RayCell& cell = cells[side];
+        cell.axis = face / 2;
+        cell.negative = face % 2 == 1;
+        cell.origin.lower = Point3(cell_lower[0], cell_lower[1], cell_lower[2]);
+        cell.origin.upper = Point3(cell_upper[0], cell_upper[1], cell_upper[2]);
+        cell.u_lower = cell_lower[kDirectionU];
+        cell.u_upper = cell_upper[kDirectionU];
+        cell.v_lower = cell_lower[kDirectionV];
+        cell.v_upper = cell_upper[kDirectionV];
+    }
+    // Children filter the parent's list, never the whole scene; keeping its order keeps
+    // them sorted.
+    // Reused per thread: a split allocates only what it keeps.
+    static thread_local std::vector<Candidate> kept[2];
+    for (auto& list : kept) list.clear();
+    for (std::uint32_t k = 0; k < node.count; ++k) {
+        const Candidate candidate = node.candidates[k];
+        const Aabb& box = boxes_[candidate.index];
+        for (int side = 0; side < 2; ++side)
+            if (detail::beam_may_hit(cells[side], box)) kept[side].push_back(candidate);
+    }
+    auto children = std::make_unique<Node[]>(2);
+    for (int side = 0; side < 2; ++side) {
+        children[side].count = static_cast<std::uint32_t>(kept[side].size());
+        children[side].candidates = std::make_unique<Candidate[]>(kept[side].size());
+        std::copy(kept[side].begin(), kept[side].end(), children[side].candidates.get());
+    }
+    const std::size_t references = kept[0].size() + kept[1].size();
+    const std::size_t bytes = references * sizeof(Candidate);
+    const std::size_t before = candidate_bytes_.fetch_add(bytes, std::memory_order_relaxed);
+    if (before + bytes > config_.max_candidate_bytes) {
+        candidate_bytes_.fetch_sub(bytes, std::memory_order_relaxed);
+        return refuse();
+    }
+    node.axis = static_cast<std::uint8_t>(axis);
+    // Release: a reader that sees the children sees their lists and the axis.
+    node.children.store(children.release(), std::memory_order_release);
+    nodes_.fetch_add(2, std::memory_order_relaxed);
+    references_.fetch_add(references, std::memory_order_relaxed);
+    // Only final leaves are ever searched (locate() returns no cell that may still split), so
+    // an inner cell's list is dead once its children exist. Root lists stay: rays too far
+    // away for the padding search them whole.
+    if (depth > 0) {
+        candidate_bytes_.fetch_sub(node.count * sizeof(Candidate), std::memory_order_relaxed);
+        references_.fetch_sub(node.count, std::memory_order_relaxed);
+        node.candidates.reset();
+    }
+    int deepest = deepest_.load(std::memory_order_relaxed);
+    while (depth + 1 > deepest &&
+           !deepest_.compare_exchange_weak(deepest, depth + 1, std::memory_order_relaxed)) {
+    }
+    lazy_nanoseconds_.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                    std::chrono::steady_clock::now() - start)
+                                    .count(),
+                                std::memory_order_relaxed);
+}
+
+template <class Set>
+const typename RayClassification<Set>::Node* RayClassification<Set>::locate(
+    int face, const double coordinates[5], TraversalCounters& counters) const {
+    Node* node = &roots_[face];
+    double lower[5], upper[5];
+    root_cell(lower, upper);
+    for (int depth = 0;; ++depth) {
+        ++counters.nodes_visited;
+        // Acquire pairs with the release in split(): once built, a path costs no lock.
+        Node* children = node->children.load(std::memory_order_acquire);
+        if (children == nullptr) {
+            if (node->count <= config_.max_leaf_candidates || depth >= config_.max_depth ||
+                node->closed.load(std::memory_order_relaxed))
+                return node;
+            split(*node, face, depth, lower, upper);
+            children = node->children.load(std::memory_order_acquire);
+            if (children == nullptr) return node;
+        }
+        const int axis = node->axis;
+        const double middle = 0.5 * lower[axis] + 0.5 * upper[axis];
+        if (coordinates[axis] < middle) {
+            upper[axis] = middle;
+            node = &children[0];
+        } else {
+            lower[axis] = middle;
+            node = &children[1];
+        }
+    }
+}
+
+template <class Set>
+typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
+    const Ray& ray, TraversalCounters& counters) const {
+    Search search;
+    if (!roots_) return search;
+    const detail::DirectionFace direction = detail::direction_face(ray.direction);
+    const int face = 2 * direction.axis + (direction.negative ? 1 : 0);
+    const double origin_size = ray.origin.cwiseAbs().maxCoeff();
+    if (hit_error_ * (origin_size + largest_coordinate_) > 0.5 * padding_) {
+        // The set's own rounding for a ray from this far may exceed the padding: test every
+        // bounded primitive, in no particular order.
+        search.candidates = roots_[face].candidates.get();
+        search.count = roots_[face].count;
+        return search;
+    }
+    ++counters.boxes_tested;
+    double t_enter, t_exit;
+    if (!scene_.intersect(ray, ray.direction.cwiseInverse(), t_enter, t_exit)) return search;
+    // Classify where the ray enters the scene box (or starts, if inside), clamped into the
+    // root cell against rounding; the padding covers the difference.
+    const Point3 entry =
+        (ray.origin + t_enter * ray.direction).cwiseMax(scene_.lower).cwiseMin(scene_.upper);
+    const double coordinates[5] = {entry.x(), entry.y(), entry.z(), direction.u, direction.v};
+    const Node* leaf = locate(face, coordinates, counters);
+    search.candidates = leaf->candidates.get();
+    search.count = leaf->count;
+    search.stops_early = true;
+    const double sign = direction.negative ? -1.0 : 1.0;
+    search.w_origin = sign * ray.origin[direction.axis];
+    search.w_speed = std::abs(ray.direction[direction.axis]);
+    return search;
+}
+
+namespace {
+/// An upper bound on the face-axis coordinate w_origin + t w_speed of the ray at t, rounded
+/// up by the error of its two operations (NaN for t = -inf, which never stops a search).
+inline double stop_position(double w_origin, double w_speed, double t) {
+    const double travel = t * w_speed;
+    return (w_origin + travel) + 4.0 * kUnitRoundoff * (std::abs(w_origin) + std::abs(travel));
+}
+}  // namespace
+
+template <class Set>
+bool RayClassification<Set>::intersect(const Ray& ray, HitRecord& record,
+                                       QueryScratch& scratch) const {
+    TraversalCounters unused;
+    return intersect_impl<false>(ray, record, scratch, unused);
+}
+
+template <class Set>
+bool RayClassification<Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
+    TraversalCounters unused;
+    return occluded_impl<false>(ray, scratch, unused);
+}
+
+template <class Set>
+bool RayClassification<Set>::intersect_counted(const Ray& ray, HitRecord& record,
+                                               QueryScratch& scratch,
+                                               TraversalCounters& counters) const {
+    return intersect_impl<true>(ray, record, scratch, counters);
+}
+
+template <class Set>
+bool RayClassification<Set>::occluded_counted(const Ray& ray, QueryScratch& scratch,
+                                              TraversalCounters& counters) const {
+    return occluded_impl<true>(ray, scratch, counters);
+}
+
+template <class Set>
+template <bool kCount>
+bool RayClassification<Set>::intersect_impl(const Ray& ray, HitRecord& record,
+                                            QueryScratch& scratch,
+                                            TraversalCounters& counters) const {
+    if (set_ == nullptr || !is_valid(ray)) return false;
+    TraversalCounters local;
+    const Search search = find_candidates(ray, local);
+    const auto prepared = set_->prepare(ray, scratch);
+    HitRecord best;
+    best.t = ray.t_max;
+    bool found = false;
+    std::uint32_t tested = 0;
+    double stop =
+        search.stops_early ? stop_position(search.w_origin, search.w_speed, best.t) : kInfinity;
+    for (std::uint32_t k = 0; k < search.count; ++k) {
+        const Candidate candidate = search.candidates[k];
+        // Sorted by where they begin along the face axis: nothing further can beat `best`.
+        if (candidate.key > stop) break;
+        ++tested;
+        if (set_->intersect(candidate.index, prepared, best)) {
+            found = true;
+            if (search.stops_early) stop = stop_position(search.w_origin, search.w_speed, best.t);
+        }
+    }
+    for (std::uint32_t index : unbounded_) found |= set_->intersect(index, prepared, best);
+    if constexpr (kCount) {
+        counters.nodes_visited += local.nodes_visited;
+        counters.boxes_tested += local.boxes_tested;
+        counters.primitives_tested += tested + unbounded_.size();
+    }
+    if (found) record = best;
+    return found;
+}
+
+template <class Set>
+template <bool kCount>
+bool RayClassification<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
+                                           TraversalCounters& counters) const {
+    if (set_ == nullptr || !is_valid(ray)) return false;
+    TraversalCounters local;
+    const Search search = find_candidates(ray, local);
+    if constexpr (kCount) {
+        counters.nodes_visited += local.nodes_visited;
+        counters.boxes_tested += local.boxes_tested;
+    }
+    const auto prepared = set_->prepare(ray, scratch);
+    const double stop =
+        search.stops_early ? stop_position(search.w_origin, search.w_speed, ray.t_max) : kInfinity;
+    for (std::uint32_t k = 0; k < search.count; ++k) {
+        const Candidate candidate = search.candidates[k];
+        if (candidate.key > stop) break;
+        if constexpr (kCount) ++counters.primitives_tested;
+        if (set_->occluded(candidate.index, prepared)) return true;
+    }
+    for (std::uint32_t index : unbounded_) {
+        if constexpr (kCount) ++counters.primitives_tested;
+        if (set_->occluded(index, prepared)) return true;
+    }
+    return false;
+}
+
+template <class Set>
+void RayClassification<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
+                                      QueryScratch& scratch) const {
+    if (set_ == nullptr || !is_valid(ray)) return;
+    TraversalCounters unused;
+    const Search search = find_candidates(ray, unused);
+    const auto prepared = set_->prepare(ray, scratch);
+    const double stop =
+        search.stops_early ? stop_position(search.w_origin, search.w_speed, ray.t_max) : kInfinity;
+    auto collect = [&](std::uint32_t index) {
+        HitRecord hit;
+        hit.t = ray.t_max;
+        if (set_->intersect(index, prepared, hit)) hits.push_back(hit);
+    };
+    // A cell's list holds each primitive once, so each is reported at most once.
+    for (std::uint32_t k = 0; k < search.count && !(search.candidates[k].key > stop); ++k)
+        collect(search.candidates[k].index);
+    for (std::uint32_t index : unbounded_) collect(index);
+}
+
+template <class Set>
+void RayClassification<Set>::prebuild(std::span<const Ray> rays) {
+    TraversalCounters unused;
+    for (const Ray& ray : rays)
+        if (set_ != nullptr && is_valid(ray)) find_candidates(ray, unused);
+}
+
+template <class Set>
+AcceleratorStats RayClassification<Set>::stats() const {
+    AcceleratorStats stats;
+    stats.name = "rayclass";
+    stats.build_milliseconds = build_milliseconds_;
+    const std::size_t nodes = nodes_.load(std::memory_order_relaxed);
+    const std::size_t candidate_bytes = candidate_bytes_.load(std::memory_order_relaxed);
+    stats.bytes = boxes_.capacity() * sizeof(Aabb) + unbounded_.capacity() * sizeof(std::uint32_t) +
+                  nodes * sizeof(Node) + candidate_bytes;
+    stats.nodes = nodes;
+    stats.references = references_.load(std::memory_order_relaxed);
+    stats.primitives = set_ != nullptr ? set_->size() : 0;
+    const std::size_t refused = splits_refused_.load(std::memory_order_relaxed);
+    const std::string cap_note =
+        refused > 0 ? ", cap reached: " + std::to_string(refused) + " splits refused" : "";
+    char details[320];
+    std::snprintf(
+        details, sizeof details,
+        "leaf <= %u, max depth %d (deepest %d), split %s, lazy splits %.1f ms, "
+        "candidate lists %.1f MiB of cap %.1f MiB%s, padding %.3g, unbounded %zu",
+        config_.max_leaf_candidates, config_.max_depth, deepest_.load(std::memory_order_relaxed),
+        config_.split == RayClassificationSplit::kCycle ? "cycle" : "widest-beam",
+        lazy_nanoseconds_.load(std::memory_order_relaxed) * 1e-6, candidate_bytes / 1048576.0,
+        config_.max_candidate_bytes / 1048576.0, cap_note.c_str(), padding_, unbounded_.size());
+    stats.details = details;
+    return stats;
+}
+
+template class RayClassification<TriangleSet<float>>;
+template class RayClassification<TriangleSet<double>>;
+template class RayClassification<ShapeSet>;
+
+}  // namespace csgrt
