@@ -20,24 +20,26 @@ namespace csgrt {
 enum class RayClassificationSplit {
     /// x, y, z, u, v in turn, by depth (Arvo & Kirk's order).
     kCycle,
-    /// The axis along which the cell's beam is widest: an origin axis by its extent, a
-    /// direction axis by its extent times the scene's depth along the face's axis (how far the
-    /// beam fans out across the scene). The dominant origin axis is never chosen (see
-    /// docs/structures.md).
-    kWidestBeam,
+    /// The axis whose halving narrows the cell's beam the most: the beam's width across the
+    /// rays is estimated from the origin extents, the origin extent along the face axis seen
+    /// at the rays' slope, and the direction extents times how far the rays can still travel
+    /// through the scene (docs/structures.md).
+    kNarrowBeam,
 };
 
 struct RayClassificationConfig {
     /// A leaf that a ray reaches is split while it holds more candidates than this.
-    std::uint32_t max_leaf_candidates = 8;
-    /// The deepest a face's tree may grow (halvings from its root), at most 60.
-    int max_depth = 40;
+    std::uint32_t max_leaf_candidates = 16;
+    /// The deepest a face's tree may grow (halvings from its root), at most 60; 0 chooses
+    /// round(2.4 log2 n) for n primitives (38 for 50k), about where a cell's beam narrows to
+    /// the size of one primitive of an evenly tessellated surface.
+    int max_depth = 0;
     /// Cap on the bytes of all candidate lists, the six root lists included. Once a split
     /// would exceed it, the leaf stays a leaf and keeps its (longer) list; stats() reports how
     /// often that happened. Answers stay exact whatever the cap (0: the six sorted root lists
     /// only).
     std::size_t max_candidate_bytes = std::size_t{1} << 30;
-    RayClassificationSplit split = RayClassificationSplit::kWidestBeam;
+    RayClassificationSplit split = RayClassificationSplit::kNarrowBeam;
     /// Subdivide every cell with more than max_leaf_candidates candidates down to this depth
     /// during build(), before any ray arrives (0: purely lazy).
     int build_depth = 0;
@@ -164,8 +166,9 @@ private:
 
     Search find_candidates(const Ray& ray, TraversalCounters& counters) const;
     /// The leaf of tree `face` holding the ray-space point `coordinates` (x, y, z, u, v),
-    /// splitting the cells on the way that are still too long.
-    const Node* locate(int face, const double coordinates[5], TraversalCounters& counters) const;
+    /// splitting the cells on the way that are still too long; writes the leaf's cell.
+    const Node* locate(int face, const double coordinates[5], TraversalCounters& counters,
+                       double lower[5], double upper[5]) const;
     void split(Node& node, int face, int depth, const double lower[5], const double upper[5]) const;
     void subdivide(Node& node, int face, int depth, double lower[5], double upper[5]);
     int split_axis(int face, int depth, const double lower[5], const double upper[5]) const;
@@ -178,8 +181,20 @@ private:
 
     const Set* set_ = nullptr;
     RayClassificationConfig config_;
+    /// A padded primitive box rounded outward to float: half the bytes of an Aabb, so the
+    /// gathers of a split miss the cache less often.
+    struct PaddedBox {
+        float lower[3];
+        float upper[3];
+        Aabb to_aabb() const {
+            Aabb box;
+            box.lower = Point3(lower[0], lower[1], lower[2]);
+            box.upper = Point3(upper[0], upper[1], upper[2]);
+            return box;
+        }
+    };
     /// Padded boxes of the bounded primitives (indexed by primitive).
-    std::vector<Aabb> boxes_;
+    std::vector<PaddedBox> boxes_;
     /// Primitives without a finite box (unbounded shapes): every ray tests them.
     std::vector<std::uint32_t> unbounded_;
     /// The union of the padded boxes, padded once more: the origin range of every root.
@@ -199,6 +214,7 @@ private:
     mutable std::atomic<std::int64_t> lazy_nanoseconds_{0};
     mutable std::atomic<int> deepest_{0};
     double build_milliseconds_ = 0.0;
+    std::uint64_t build_id_ = 0;
 };
 
 class ShapeSet;
