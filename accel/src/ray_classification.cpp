@@ -360,7 +360,7 @@ const typename RayClassification<Set>::Node* RayClassification<Set>::locate(
                 return node;
             split(*node, face, depth, lower, upper);
             children = node->children.load(std::memory_order_acquire);
-            if (children == nullptr) return node;
+            if (children == nullptr) return node;  // the memory cap refused the split
         }
         const int axis = node->axis;
         const double middle = 0.5 * lower[axis] + 0.5 * upper[axis];
@@ -397,7 +397,8 @@ typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
     const Point3 entry =
         (ray.origin + t_enter * ray.direction).cwiseMax(scene_.lower).cwiseMin(scene_.upper);
     const double coordinates[5] = {entry.x(), entry.y(), entry.z(), direction.u, direction.v};
-    // Any leaf whose closed cell holds the ray's point has every candidate the ray needs.
+    // Any leaf whose closed cell holds the ray's point has every candidate the ray needs; a
+    // final leaf is never split, so its cached cell stays valid as long as the build.
     LeafCache& cache = leaf_cache;
     bool cached = cache.build_id == build_id_ && cache.face == face;
     for (int k = 0; k < 5 && cached; ++k)
@@ -423,6 +424,11 @@ typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
 }
 
 namespace {
+/// Lists longer than this (cells that the memory cap or max_depth left long) test each
+/// candidate's padded box before the primitive: a slab test is cheaper than most primitive
+/// tests, and in a long list most candidates are far from the ray.
+constexpr std::uint32_t kBoxTestedLength = 64;
+
 /// An upper bound on the face-axis coordinate w_origin + t w_speed of the ray at t, rounded
 /// up by the error of its two operations (NaN for t = -inf, which never stops a search).
 inline double stop_position(double w_origin, double w_speed, double t) {
@@ -472,10 +478,22 @@ bool RayClassification<Set>::intersect_impl(const Ray& ray, HitRecord& record,
     std::uint32_t tested = 0;
     double stop =
         search.stops_early ? stop_position(search.w_origin, search.w_speed, best.t) : kInfinity;
+    // Far rays (no early stop) may hit outside the padded boxes: never box-test them.
+    const bool box_tested = search.stops_early && search.count > kBoxTestedLength;
+    const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    Ray bounded = ray;
     for (std::uint32_t k = 0; k < search.count; ++k) {
         const Candidate candidate = search.candidates[k];
         // Sorted by where they begin along the face axis: nothing further can beat `best`.
         if (candidate.key > stop) break;
+        if (box_tested) {
+            if constexpr (kCount) ++counters.boxes_tested;
+            bounded.t_max = best.t;
+            double t_enter, t_exit;
+            if (!boxes_[candidate.index].to_aabb().intersect(bounded, inverse_direction, t_enter,
+                                                             t_exit))
+                continue;
+        }
         ++tested;
         if (set_->intersect(candidate.index, prepared, best)) {
             found = true;
@@ -506,9 +524,19 @@ bool RayClassification<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch
     const auto prepared = set_->prepare(ray, scratch);
     const double stop =
         search.stops_early ? stop_position(search.w_origin, search.w_speed, ray.t_max) : kInfinity;
+    // Far rays (no early stop) may hit outside the padded boxes: never box-test them.
+    const bool box_tested = search.stops_early && search.count > kBoxTestedLength;
+    const Vector3 inverse_direction = ray.direction.cwiseInverse();
     for (std::uint32_t k = 0; k < search.count; ++k) {
         const Candidate candidate = search.candidates[k];
         if (candidate.key > stop) break;
+        if (box_tested) {
+            if constexpr (kCount) ++counters.boxes_tested;
+            double t_enter, t_exit;
+            if (!boxes_[candidate.index].to_aabb().intersect(ray, inverse_direction, t_enter,
+                                                             t_exit))
+                continue;
+        }
         if constexpr (kCount) ++counters.primitives_tested;
         if (set_->occluded(candidate.index, prepared)) return true;
     }
@@ -533,9 +561,17 @@ void RayClassification<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hi
         hit.t = ray.t_max;
         if (set_->intersect(index, prepared, hit)) hits.push_back(hit);
     };
+    // Far rays (no early stop) may hit outside the padded boxes: never box-test them.
+    const bool box_tested = search.stops_early && search.count > kBoxTestedLength;
+    const Vector3 inverse_direction = ray.direction.cwiseInverse();
     // A cell's list holds each primitive once, so each is reported at most once.
-    for (std::uint32_t k = 0; k < search.count && !(search.candidates[k].key > stop); ++k)
-        collect(search.candidates[k].index);
+    for (std::uint32_t k = 0; k < search.count && !(search.candidates[k].key > stop); ++k) {
+        const std::uint32_t index = search.candidates[k].index;
+        double t_enter, t_exit;
+        if (!box_tested ||
+            boxes_[index].to_aabb().intersect(ray, inverse_direction, t_enter, t_exit))
+            collect(index);
+    }
     for (std::uint32_t index : unbounded_) collect(index);
 }
 

@@ -38,7 +38,7 @@ struct RayClassificationConfig {
     /// would exceed it, the leaf stays a leaf and keeps its (longer) list; stats() reports how
     /// often that happened. Answers stay exact whatever the cap (0: the six sorted root lists
     /// only).
-    std::size_t max_candidate_bytes = std::size_t{1} << 30;
+    std::size_t max_candidate_bytes = std::size_t{256} << 20;
     RayClassificationSplit split = RayClassificationSplit::kNarrowBeam;
     /// Subdivide every cell with more than max_leaf_candidates candidates down to this depth
     /// during build(), before any ray arrives (0: purely lazy).
@@ -165,10 +165,12 @@ private:
     };
 
     Search find_candidates(const Ray& ray, TraversalCounters& counters) const;
-    /// The leaf of tree `face` holding the ray-space point `coordinates` (x, y, z, u, v),
-    /// splitting the cells on the way that are still too long; writes the leaf's cell.
+    /// The final leaf (one never to be split) of tree `face` holding the ray-space point
+    /// `coordinates` (x, y, z, u, v), splitting the cells on the way that are still too long;
+    /// writes the leaf's cell.
     const Node* locate(int face, const double coordinates[5], TraversalCounters& counters,
                        double lower[5], double upper[5]) const;
+    /// Splits `node` (or closes it at the memory cap) unless another thread already has.
     void split(Node& node, int face, int depth, const double lower[5], const double upper[5]) const;
     void subdivide(Node& node, int face, int depth, double lower[5], double upper[5]);
     int split_axis(int face, int depth, const double lower[5], const double upper[5]) const;
