@@ -293,6 +293,7 @@ void RayClassification<Set>::split(Node& node, int face, int depth, const double
         cell.v_lower = cell_lower[kDirectionV];
         cell.v_upper = cell_upper[kDirectionV];
     }
+    const detail::Beam beams[2] = {detail::Beam(cells[0]), detail::Beam(cells[1])};
     // Children filter the parent's list, never the whole scene; keeping its order keeps
     // them sorted.
     // Reused per thread: a split allocates only what it keeps.
@@ -304,9 +305,9 @@ void RayClassification<Set>::split(Node& node, int face, int depth, const double
         if (k + kPrefetchDistance < node.count)
             __builtin_prefetch(&boxes_[node.candidates[k + kPrefetchDistance].index]);
         const Candidate candidate = node.candidates[k];
-        const Aabb box = boxes_[candidate.index].to_aabb();
+        const PaddedBox& box = boxes_[candidate.index];
         for (int side = 0; side < 2; ++side)
-            if (detail::beam_may_hit(cells[side], box)) kept[side].push_back(candidate);
+            if (beams[side].may_hit(box.lower, box.upper)) kept[side].push_back(candidate);
     }
     auto children = std::make_unique<Node[]>(2);
     for (int side = 0; side < 2; ++side) {

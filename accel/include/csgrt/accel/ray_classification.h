@@ -75,29 +75,57 @@ struct RayCell {
 /// over that t range (Arvo & Kirk, "Fast Ray Tracing by Ray Classification", SIGGRAPH 1987).
 /// Exact arithmetic would make it conservative; in double it may miss a box by a few ulps of
 /// the coordinates, which the structure's box padding covers.
-inline bool beam_may_hit(const RayCell& cell, const Aabb& box) {
-    const int a = cell.axis, b = (a + 1) % 3, c = (a + 2) % 3;
-    // Along the face axis a ray advances by exactly t (its direction is ±e_a + ...), so the
-    // parameters at which some ray of the cell is inside the box's slab form this interval.
-    double t_lower, t_upper;
-    if (cell.negative) {
-        t_lower = cell.origin.lower[a] - box.upper[a];
-        t_upper = cell.origin.upper[a] - box.lower[a];
-    } else {
-        t_lower = box.lower[a] - cell.origin.upper[a];
-        t_upper = box.upper[a] - cell.origin.lower[a];
+class Beam {
+public:
+    explicit Beam(const RayCell& cell)
+        : a_(cell.axis),
+          b_((cell.axis + 1) % 3),
+          c_((cell.axis + 2) % 3),
+          negative_(cell.negative) {
+        // On a negative face the face axis is mirrored, so rays always advance along +a.
+        origin_lower_a_ = negative_ ? -cell.origin.upper[a_] : cell.origin.lower[a_];
+        origin_upper_a_ = negative_ ? -cell.origin.lower[a_] : cell.origin.upper[a_];
+        origin_lower_b_ = cell.origin.lower[b_];
+        origin_upper_b_ = cell.origin.upper[b_];
+        origin_lower_c_ = cell.origin.lower[c_];
+        origin_upper_c_ = cell.origin.upper[c_];
+        u_lower_ = cell.u_lower;
+        u_upper_ = cell.u_upper;
+        v_lower_ = cell.v_lower;
+        v_upper_ = cell.v_upper;
     }
-    t_lower = std::max(t_lower, 0.0);
-    if (!(t_lower <= t_upper)) return false;
-    // Over that t range the other coordinates are o_k + t w, w in [w_lower, w_upper]: the
-    // product is bilinear, so its extremes are at the corners, and t >= 0 picks which.
-    auto spread_meets = [&](int k, double w_lower, double w_upper) {
-        const double low = cell.origin.lower[k] + std::min(t_lower * w_lower, t_upper * w_lower);
-        const double high = cell.origin.upper[k] + std::max(t_lower * w_upper, t_upper * w_upper);
-        return low <= box.upper[k] && high >= box.lower[k];
-    };
-    return spread_meets(b, cell.u_lower, cell.u_upper) &&
-           spread_meets(c, cell.v_lower, cell.v_upper);
+
+    /// The test for the box [lower, upper] (float or double corners).
+    template <class Real>
+    bool may_hit(const Real* lower, const Real* upper) const {
+        const double box_lower_a = negative_ ? -double(upper[a_]) : double(lower[a_]);
+        const double box_upper_a = negative_ ? -double(lower[a_]) : double(upper[a_]);
+        // Along the face axis a ray advances by exactly t (its direction is e_a + ...), so
+        // the parameters at which some ray is inside the box's slab form this interval.
+        const double t_lower = std::max(box_lower_a - origin_upper_a_, 0.0);
+        const double t_upper = box_upper_a - origin_lower_a_;
+        if (!(t_lower <= t_upper)) return false;
+        // Over that t range the other coordinates are o_k + t w, w in [w_lower, w_upper]:
+        // the product is bilinear, so its extremes are at corners, and t >= 0 says which.
+        const double low_b = origin_lower_b_ + (u_lower_ >= 0.0 ? t_lower : t_upper) * u_lower_;
+        const double high_b = origin_upper_b_ + (u_upper_ >= 0.0 ? t_upper : t_lower) * u_upper_;
+        const double low_c = origin_lower_c_ + (v_lower_ >= 0.0 ? t_lower : t_upper) * v_lower_;
+        const double high_c = origin_upper_c_ + (v_upper_ >= 0.0 ? t_upper : t_lower) * v_upper_;
+        return low_b <= double(upper[b_]) && high_b >= double(lower[b_]) &&
+               low_c <= double(upper[c_]) && high_c >= double(lower[c_]);
+    }
+
+private:
+    int a_, b_, c_;
+    bool negative_;
+    double origin_lower_a_, origin_upper_a_, origin_lower_b_, origin_upper_b_;
+    double origin_lower_c_, origin_upper_c_;
+    double u_lower_, u_upper_, v_lower_, v_upper_;
+};
+
+/// The beam test of `cell` for one box (see Beam).
+inline bool beam_may_hit(const RayCell& cell, const Aabb& box) {
+    return Beam(cell).may_hit(box.lower.data(), box.upper.data());
 }
 
 }  // namespace detail
