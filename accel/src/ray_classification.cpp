@@ -74,16 +74,29 @@ thread_local LeafCache leaf_cache;
 
 template <class Set>
 struct RayClassification<Set>::Node {
-    /// Two children, published with release once they are complete; null for a leaf.
+    /// Two children, published with release once created; null for a leaf. A child's list
+    /// is filtered from this node's list when a ray first reaches it (`ready`).
     std::atomic<Node*> children{nullptr};
-    std::unique_ptr<Candidate[]> candidates;
+    /// The candidates, sorted by key; owned unless `borrowed` (then the parent's list).
+    const Candidate* candidates = nullptr;
     std::uint32_t count = 0;
     /// The axis (x, y, z, u, v) the cell was halved along; written before `children`.
     std::uint8_t axis = 0;
+    /// Set with release once `candidates` and `count` are final.
+    std::atomic<bool> ready{false};
     /// Set when a split was refused (memory cap): the leaf is final.
     std::atomic<bool> closed{false};
+    /// The list is the parent's, shared because the memory cap refused a copy.
+    bool borrowed = false;
+    /// Under this node's lock: how many children have their lists, and whether one borrows
+    /// this node's list (which must then live on).
+    std::uint8_t ready_children = 0;
+    bool lent = false;
 
-    ~Node() { delete[] children.load(std::memory_order_relaxed); }
+    ~Node() {
+        if (!borrowed) delete[] candidates;
+        delete[] children.load(std::memory_order_relaxed);
+    }
 };
 
 template <class Set>
@@ -172,18 +185,19 @@ void RayClassification<Set>::build(const Set& set, const RayClassificationConfig
             const int axis = face / 2;
             const bool negative = face % 2 == 1;
             root.count = static_cast<std::uint32_t>(bounded.size());
-            root.candidates = std::make_unique<Candidate[]>(bounded.size());
+            Candidate* list = new Candidate[bounded.size()];
+            root.candidates = list;
             for (std::size_t k = 0; k < bounded.size(); ++k) {
                 const Aabb& box = boxes[bounded[k]];
                 // The coordinate that grows along the face's rays: x_a, or -x_a on a negative
                 // face; a box begins where that coordinate is smallest.
                 const double begin = negative ? -box.upper[axis] : box.lower[axis];
-                root.candidates[k] = Candidate{round_down(begin), bounded[k]};
+                list[k] = Candidate{round_down(begin), bounded[k]};
             }
-            std::sort(root.candidates.get(), root.candidates.get() + root.count,
-                      [](const Candidate& x, const Candidate& y) {
-                          return x.key < y.key || (x.key == y.key && x.index < y.index);
-                      });
+            std::sort(list, list + root.count, [](const Candidate& x, const Candidate& y) {
+                return x.key < y.key || (x.key == y.key && x.index < y.index);
+            });
+            root.ready.store(true, std::memory_order_relaxed);
         }
         nodes_ = 6;
         references_ = 6 * bounded.size();
@@ -219,13 +233,14 @@ void RayClassification<Set>::subdivide(Node& node, int face, int depth, double l
     if (children == nullptr) return;
     const int axis = node.axis;
     const double middle = 0.5 * lower[axis] + 0.5 * upper[axis];
-    const double saved_lower = lower[axis], saved_upper = upper[axis];
-    upper[axis] = middle;
-    subdivide(children[0], face, depth + 1, lower, upper);
-    upper[axis] = saved_upper;
-    lower[axis] = middle;
-    subdivide(children[1], face, depth + 1, lower, upper);
-    lower[axis] = saved_lower;
+    for (int side = 0; side < 2; ++side) {
+        double child_lower[5], child_upper[5];
+        std::copy(lower, lower + 5, child_lower);
+        std::copy(upper, upper + 5, child_upper);
+        (side == 0 ? child_upper : child_lower)[axis] = middle;
+        materialize(node, children[side], face, depth + 1, child_lower, child_upper);
+        subdivide(children[side], face, depth + 1, child_lower, child_upper);
+    }
 }
 
 template <class Set>
@@ -259,85 +274,91 @@ int RayClassification<Set>::split_axis(int face, int depth, const double lower[5
 }
 
 template <class Set>
+std::mutex& RayClassification<Set>::lock_of(const Node& node) const {
+    return split_locks_[(reinterpret_cast<std::uintptr_t>(&node) / sizeof(Node)) %
+                        split_locks_.size()];
+}
+
+template <class Set>
 void RayClassification<Set>::split(Node& node, int face, int depth, const double lower[5],
                                    const double upper[5]) const {
-    const auto start = std::chrono::steady_clock::now();
-    const auto stripe =
-        (reinterpret_cast<std::uintptr_t>(&node) / sizeof(Node)) % split_locks_.size();
-    std::lock_guard<std::mutex> lock(split_locks_[stripe]);
+    std::lock_guard<std::mutex> lock(lock_of(node));
     if (node.children.load(std::memory_order_relaxed) != nullptr ||
         node.closed.load(std::memory_order_relaxed))
         return;
-    auto refuse = [&] {
+    if (candidate_bytes_.load(std::memory_order_relaxed) >= config_.max_candidate_bytes) {
         node.closed.store(true, std::memory_order_relaxed);
         splits_refused_.fetch_add(1, std::memory_order_relaxed);
-    };
-    if (candidate_bytes_.load(std::memory_order_relaxed) >= config_.max_candidate_bytes)
-        return refuse();
-
-    const int axis = split_axis(face, depth, lower, upper);
-    const double middle = 0.5 * lower[axis] + 0.5 * upper[axis];
-    detail::RayCell cells[2];
-    for (int side = 0; side < 2; ++side) {
-        double cell_lower[5], cell_upper[5];
-        std::copy(lower, lower + 5, cell_lower);
-        std::copy(upper, upper + 5, cell_upper);
-        (side == 0 ? cell_upper : cell_lower)[axis] = middle;
-        detail::RayCell& cell = cells[side];
-        cell.axis = face / 2;
-        cell.negative = face % 2 == 1;
-        cell.origin.lower = Point3(cell_lower[0], cell_lower[1], cell_lower[2]);
-        cell.origin.upper = Point3(cell_upper[0], cell_upper[1], cell_upper[2]);
-        cell.u_lower = cell_lower[kDirectionU];
-        cell.u_upper = cell_upper[kDirectionU];
-        cell.v_lower = cell_lower[kDirectionV];
-        cell.v_upper = cell_upper[kDirectionV];
+        return;
     }
-    const detail::Beam beams[2] = {detail::Beam(cells[0]), detail::Beam(cells[1])};
-    // Children filter the parent's list, never the whole scene; keeping its order keeps
-    // them sorted.
-    // Reused per thread: a split allocates only what it keeps.
-    static thread_local std::vector<Candidate> kept[2];
-    for (auto& list : kept) list.clear();
-    constexpr std::uint32_t kPrefetchDistance = 8;
-    for (std::uint32_t k = 0; k < node.count; ++k) {
-        // The boxes are gathered in list order, which is not memory order.
-        if (k + kPrefetchDistance < node.count)
-            __builtin_prefetch(&boxes_[node.candidates[k + kPrefetchDistance].index]);
-        const Candidate candidate = node.candidates[k];
-        const PaddedBox& box = boxes_[candidate.index];
-        for (int side = 0; side < 2; ++side)
-            if (beams[side].may_hit(box.lower, box.upper)) kept[side].push_back(candidate);
-    }
-    auto children = std::make_unique<Node[]>(2);
-    for (int side = 0; side < 2; ++side) {
-        children[side].count = static_cast<std::uint32_t>(kept[side].size());
-        children[side].candidates = std::make_unique<Candidate[]>(kept[side].size());
-        std::copy(kept[side].begin(), kept[side].end(), children[side].candidates.get());
-    }
-    const std::size_t references = kept[0].size() + kept[1].size();
-    const std::size_t bytes = references * sizeof(Candidate);
-    const std::size_t before = candidate_bytes_.fetch_add(bytes, std::memory_order_relaxed);
-    if (before + bytes > config_.max_candidate_bytes) {
-        candidate_bytes_.fetch_sub(bytes, std::memory_order_relaxed);
-        return refuse();
-    }
-    node.axis = static_cast<std::uint8_t>(axis);
-    // Release: a reader that sees the children sees their lists and the axis.
-    node.children.store(children.release(), std::memory_order_release);
+    node.axis = static_cast<std::uint8_t>(split_axis(face, depth, lower, upper));
+    // Release: a reader that sees the children sees the axis. Their lists come later.
+    node.children.store(new Node[2], std::memory_order_release);
     nodes_.fetch_add(2, std::memory_order_relaxed);
-    references_.fetch_add(references, std::memory_order_relaxed);
-    // Only final leaves are ever searched (locate() returns no cell that may still split), so
-    // an inner cell's list is dead once its children exist. Root lists stay: rays too far
-    // away for the padding search them whole.
-    if (depth > 0) {
-        candidate_bytes_.fetch_sub(node.count * sizeof(Candidate), std::memory_order_relaxed);
-        references_.fetch_sub(node.count, std::memory_order_relaxed);
-        node.candidates.reset();
-    }
     int deepest = deepest_.load(std::memory_order_relaxed);
     while (depth + 1 > deepest &&
            !deepest_.compare_exchange_weak(deepest, depth + 1, std::memory_order_relaxed)) {
+    }
+}
+
+template <class Set>
+void RayClassification<Set>::materialize(Node& parent, Node& child, int face, int depth,
+                                         const double lower[5], const double upper[5]) const {
+    const auto start = std::chrono::steady_clock::now();
+    // The parent's lock: both children read the parent's list, and the second frees it.
+    std::lock_guard<std::mutex> lock(lock_of(parent));
+    if (child.ready.load(std::memory_order_relaxed)) return;
+    detail::RayCell cell;
+    cell.axis = face / 2;
+    cell.negative = face % 2 == 1;
+    cell.origin.lower = Point3(lower[0], lower[1], lower[2]);
+    cell.origin.upper = Point3(upper[0], upper[1], upper[2]);
+    cell.u_lower = lower[kDirectionU];
+    cell.u_upper = upper[kDirectionU];
+    cell.v_lower = lower[kDirectionV];
+    cell.v_upper = upper[kDirectionV];
+    const detail::Beam beam(cell);
+    // A child filters its parent's list, never the whole scene; keeping its order keeps it
+    // sorted. Reused per thread, so only what is kept is allocated.
+    static thread_local std::vector<Candidate> kept;
+    kept.clear();
+    constexpr std::uint32_t kPrefetchDistance = 8;
+    for (std::uint32_t k = 0; k < parent.count; ++k) {
+        // The boxes are gathered in list order, which is not memory order.
+        if (k + kPrefetchDistance < parent.count)
+            __builtin_prefetch(&boxes_[parent.candidates[k + kPrefetchDistance].index]);
+        const Candidate candidate = parent.candidates[k];
+        const PaddedBox& box = boxes_[candidate.index];
+        if (beam.may_hit(box.lower, box.upper)) kept.push_back(candidate);
+    }
+    const std::size_t bytes = kept.size() * sizeof(Candidate);
+    const std::size_t before = candidate_bytes_.fetch_add(bytes, std::memory_order_relaxed);
+    if (before + bytes > config_.max_candidate_bytes) {
+        // No room for a copy: keep using the parent's list, and split no further here.
+        candidate_bytes_.fetch_sub(bytes, std::memory_order_relaxed);
+        splits_refused_.fetch_add(1, std::memory_order_relaxed);
+        child.candidates = parent.candidates;
+        child.count = parent.count;
+        child.borrowed = true;
+        child.closed.store(true, std::memory_order_relaxed);
+        parent.lent = true;
+    } else {
+        Candidate* list = new Candidate[kept.size()];
+        std::copy(kept.begin(), kept.end(), list);
+        child.candidates = list;
+        child.count = static_cast<std::uint32_t>(kept.size());
+        references_.fetch_add(kept.size(), std::memory_order_relaxed);
+    }
+    // Release: a reader that sees `ready` sees the list.
+    child.ready.store(true, std::memory_order_release);
+    // Once both children have their lists nothing reads the parent's (only final leaves are
+    // searched), unless a child borrows it. Root lists stay: rays too far away for the
+    // padding search them whole.
+    if (++parent.ready_children == 2 && !parent.lent && depth > 1) {
+        candidate_bytes_.fetch_sub(parent.count * sizeof(Candidate), std::memory_order_relaxed);
+        references_.fetch_sub(parent.count, std::memory_order_relaxed);
+        delete[] parent.candidates;
+        parent.candidates = nullptr;
     }
     lazy_nanoseconds_.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                     std::chrono::steady_clock::now() - start)
@@ -353,7 +374,8 @@ const typename RayClassification<Set>::Node* RayClassification<Set>::locate(
     root_cell(lower, upper);
     for (int depth = 0;; ++depth) {
         ++counters.nodes_visited;
-        // Acquire pairs with the release in split(): once built, a path costs no lock.
+        // Acquire pairs with the releases in split() and materialize(): once built, a path
+        // costs no lock.
         Node* children = node->children.load(std::memory_order_acquire);
         if (children == nullptr) {
             if (node->count <= config_.max_leaf_candidates || depth >= config_.max_depth ||
@@ -365,6 +387,7 @@ const typename RayClassification<Set>::Node* RayClassification<Set>::locate(
         }
         const int axis = node->axis;
         const double middle = 0.5 * lower[axis] + 0.5 * upper[axis];
+        Node* parent = node;
         if (coordinates[axis] < middle) {
             upper[axis] = middle;
             node = &children[0];
@@ -372,6 +395,8 @@ const typename RayClassification<Set>::Node* RayClassification<Set>::locate(
             lower[axis] = middle;
             node = &children[1];
         }
+        if (!node->ready.load(std::memory_order_acquire))
+            materialize(*parent, *node, face, depth + 1, lower, upper);
     }
 }
 
@@ -386,7 +411,7 @@ typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
     if (hit_error_ * (origin_size + largest_coordinate_) > 0.5 * padding_) {
         // The set's own rounding for a ray from this far may exceed the padding: test every
         // bounded primitive, in no particular order.
-        search.candidates = roots_[face].candidates.get();
+        search.candidates = roots_[face].candidates;
         search.count = roots_[face].count;
         return search;
     }
@@ -415,7 +440,7 @@ typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
         cache.face = face;
         cache.leaf = leaf;
     }
-    search.candidates = leaf->candidates.get();
+    search.candidates = leaf->candidates;
     search.count = leaf->count;
     search.stops_early = true;
     const double sign = direction.negative ? -1.0 : 1.0;

@@ -198,8 +198,14 @@ private:
     /// writes the leaf's cell.
     const Node* locate(int face, const double coordinates[5], TraversalCounters& counters,
                        double lower[5], double upper[5]) const;
-    /// Splits `node` (or closes it at the memory cap) unless another thread already has.
+    /// Gives `node` two children without lists (or closes it at the memory cap), unless
+    /// another thread already has.
     void split(Node& node, int face, int depth, const double lower[5], const double upper[5]) const;
+    /// Filters `child`'s list (cell [lower, upper]) from `parent`'s, unless another thread
+    /// already has; frees the parent's list once both children have theirs.
+    void materialize(Node& parent, Node& child, int face, int depth, const double lower[5],
+                     const double upper[5]) const;
+    std::mutex& lock_of(const Node& node) const;
     void subdivide(Node& node, int face, int depth, double lower[5], double upper[5]);
     int split_axis(int face, int depth, const double lower[5], const double upper[5]) const;
     void root_cell(double lower[5], double upper[5]) const;
