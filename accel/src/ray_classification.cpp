@@ -54,6 +54,10 @@ float round_down(double value) {
 constexpr int kDirectionU = 3;
 constexpr int kDirectionV = 4;
 
+/// How many candidates ahead a list walk prefetches their boxes: a list is in key order, not
+/// memory order, so each box is a gather.
+constexpr std::uint32_t kPrefetchDistance = 8;
+
 /// Numbers every build of every RayClassification, so a thread's cached leaf can never be
 /// mistaken for a leaf of another structure, or of a rebuilt one at the same address.
 std::atomic<std::uint64_t> next_build_id{1};
@@ -322,9 +326,7 @@ void RayClassification<Set>::materialize(Node& parent, Node& child, int face, in
     // sorted. Reused per thread, so only what is kept is allocated.
     static thread_local std::vector<Candidate> kept;
     kept.clear();
-    constexpr std::uint32_t kPrefetchDistance = 8;
     for (std::uint32_t k = 0; k < parent.count; ++k) {
-        // The boxes are gathered in list order, which is not memory order.
         if (k + kPrefetchDistance < parent.count)
             __builtin_prefetch(&boxes_[parent.candidates[k + kPrefetchDistance].index]);
         const Candidate candidate = parent.candidates[k];
@@ -514,6 +516,8 @@ bool RayClassification<Set>::intersect_impl(const Ray& ray, HitRecord& record,
         if (candidate.key > stop) break;
         if (box_tested) {
             if constexpr (kCount) ++counters.boxes_tested;
+            if (k + kPrefetchDistance < search.count)
+                __builtin_prefetch(&boxes_[search.candidates[k + kPrefetchDistance].index]);
             bounded.t_max = best.t;
             double t_enter, t_exit;
             if (!boxes_[candidate.index].to_aabb().intersect(bounded, inverse_direction, t_enter,
@@ -558,6 +562,8 @@ bool RayClassification<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch
         if (candidate.key > stop) break;
         if (box_tested) {
             if constexpr (kCount) ++counters.boxes_tested;
+            if (k + kPrefetchDistance < search.count)
+                __builtin_prefetch(&boxes_[search.candidates[k + kPrefetchDistance].index]);
             double t_enter, t_exit;
             if (!boxes_[candidate.index].to_aabb().intersect(ray, inverse_direction, t_enter,
                                                              t_exit))
