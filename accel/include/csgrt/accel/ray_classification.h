@@ -34,10 +34,10 @@ struct RayClassificationConfig {
     /// round(2.4 log2 n) for n primitives (38 for 50k), about where a cell's beam narrows to
     /// the size of one primitive of an evenly tessellated surface.
     int max_depth = 0;
-    /// Cap on the bytes of all candidate lists, the six root lists included. Once a split
-    /// would exceed it, the leaf stays a leaf and keeps its (longer) list; stats() reports how
-    /// often that happened. Answers stay exact whatever the cap (0: the six sorted root lists
-    /// only).
+    /// Cap on the bytes of all candidate lists, the six root lists included. Once it is
+    /// reached cells stop splitting, and a new cell whose list would not fit searches its
+    /// parent's (longer) list; stats() reports how often either happened. Answers stay exact
+    /// whatever the cap (0: the six sorted root lists only).
     std::size_t max_candidate_bytes = std::size_t{256} << 20;
     RayClassificationSplit split = RayClassificationSplit::kNarrowBeam;
     /// Subdivide every cell with more than max_leaf_candidates candidates down to this depth
@@ -167,7 +167,8 @@ public:
     /// Bytes of all candidate lists now held (never above the cap, unless the six root lists
     /// alone are).
     std::size_t candidate_bytes() const { return candidate_bytes_.load(std::memory_order_relaxed); }
-    /// Splits refused because they would have exceeded max_candidate_bytes.
+    /// Splits refused, and cells left with their parent's list, because of
+    /// max_candidate_bytes.
     std::size_t splits_refused() const { return splits_refused_.load(std::memory_order_relaxed); }
     /// The half-width added to every primitive box, in scene units.
     double box_padding() const { return padding_; }
@@ -178,6 +179,18 @@ private:
     struct Candidate {
         float key;
         std::uint32_t index;
+    };
+    /// A padded primitive box rounded outward to float: half the bytes of an Aabb, so the
+    /// gathers of a split miss the cache less often.
+    struct PaddedBox {
+        float lower[3];
+        float upper[3];
+        Aabb to_aabb() const {
+            Aabb box;
+            box.lower = Point3(lower[0], lower[1], lower[2]);
+            box.upper = Point3(upper[0], upper[1], upper[2]);
+            return box;
+        }
     };
     struct Node;
     /// The candidates one ray must test: a leaf's list (sorted, so the search may stop early)
@@ -217,18 +230,6 @@ private:
 
     const Set* set_ = nullptr;
     RayClassificationConfig config_;
-    /// A padded primitive box rounded outward to float: half the bytes of an Aabb, so the
-    /// gathers of a split miss the cache less often.
-    struct PaddedBox {
-        float lower[3];
-        float upper[3];
-        Aabb to_aabb() const {
-            Aabb box;
-            box.lower = Point3(lower[0], lower[1], lower[2]);
-            box.upper = Point3(upper[0], upper[1], upper[2]);
-            return box;
-        }
-    };
     /// Padded boxes of the bounded primitives (indexed by primitive).
     std::vector<PaddedBox> boxes_;
     /// Primitives without a finite box (unbounded shapes): every ray tests them.
