@@ -23,8 +23,8 @@ std::vector<csgrt::Ray> rays_toward(const csgrt::Aabb& box, int count) {
     std::vector<csgrt::Ray> rays;
     for (int i = 0; i < count; ++i) {
         const csgrt::Vector3 from(unit(engine) - 0.5, unit(engine) - 0.5, unit(engine) - 0.5);
-        const csgrt::Point3 aim = target.lower + target.diagonal().cwiseProduct(
-                                                     csgrt::Vector3(unit(engine), unit(engine), unit(engine)));
+        const csgrt::Point3 aim = target.lower + target.diagonal().cwiseProduct(csgrt::Vector3(
+                                                     unit(engine), unit(engine), unit(engine)));
         const csgrt::Point3 origin = target.center() + from.normalized() * radius;
         rays.push_back(csgrt::Ray{origin, aim - origin});
     }
@@ -37,8 +37,9 @@ int main() {
     using namespace csgrt;
     const std::vector<Row> rows = {
         {"sphere", std::make_shared<Sphere>(Point3(0, 0, 0), 1.0)},
-        {"instance(sphere)", std::make_shared<Instance>(std::make_shared<Sphere>(Point3(0, 0, 0), 1.0),
-                                                       Transform::scale(Vector3(2, 1, 0.5)))},
+        {"instance(sphere)",
+         std::make_shared<Instance>(std::make_shared<Sphere>(Point3(0, 0, 0), 1.0),
+                                    Transform::scale(Vector3(2, 1, 0.5)))},
     };
     constexpr int kRays = 200000;
     std::printf("%-28s %10s %8s %12s %10s\n", "shape", "rays", "hit %", "mean t", "Mrays/s");

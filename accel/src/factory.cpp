@@ -10,7 +10,7 @@
 namespace csgrt {
 
 namespace {
-constexpr std::array<std::string_view, 2> kNames = {"brute", "rayclass"};
+constexpr std::array<std::string_view, 3> kNames = {"brute", "rayclass", "bvh"};
 
 template <class Structure, class Set, class Config>
 std::unique_ptr<Accelerator<Set>> build(const Set& set, const Config& config) {
@@ -29,6 +29,7 @@ std::unique_ptr<Accelerator<Set>> make_accelerator(std::string_view name, const 
                                                    const AcceleratorConfig& config) {
     if (name == "brute") return build<BruteForce<Set>>(set, config.brute_force);
     if (name == "rayclass") return build<RayClassification<Set>>(set, config.ray_classification);
+    if (name == "bvh") return build<Bvh<Set>>(set, config.bvh);
     std::string known;
     for (std::string_view n : kNames) known.append(known.empty() ? "" : ", ").append(n);
     require(false, "make_accelerator", "name", "one of " + known, std::string(name));

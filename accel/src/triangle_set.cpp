@@ -25,7 +25,8 @@ template <class Real>
 Point3 TriangleSet<Real>::centroid(std::size_t i) const {
     const auto& c = corners_[i];
     return (c[0].template cast<double>() + c[1].template cast<double>() +
-            c[2].template cast<double>()) / 3.0;
+            c[2].template cast<double>()) /
+           3.0;
 }
 
 template <class Real>

@@ -48,7 +48,8 @@ bool Instance::contains(const Point3& p) const {
 Hit Instance::to_world(const Hit& object_hit) const {
     Hit hit = object_hit;
     hit.point = world_from_object_.apply_point(object_hit.point);
-    hit.geometric_normal = world_from_object_.apply_normal(object_hit.geometric_normal).normalized();
+    hit.geometric_normal =
+        world_from_object_.apply_normal(object_hit.geometric_normal).normalized();
     hit.shading_normal = world_from_object_.apply_normal(object_hit.shading_normal).normalized();
     // front_face needs no update: d_world . (L^-T n) = (L d) . (L^-T n) = d . n.
     return hit;

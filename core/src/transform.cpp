@@ -15,9 +15,11 @@ Transform::Transform()
 
 Transform::Transform(const Eigen::Matrix3d& linear, const Vector3& translation)
     : linear_(linear), translation_(translation) {
-    require(linear.allFinite(), "Transform", "every matrix entry", "finite", linear.reshaped().eval());
+    require(linear.allFinite(), "Transform", "every matrix entry", "finite",
+            linear.reshaped().eval());
     require_finite(translation, "Transform", "translation");
-    const double column_lengths = linear.col(0).norm() * linear.col(1).norm() * linear.col(2).norm();
+    const double column_lengths =
+        linear.col(0).norm() * linear.col(1).norm() * linear.col(2).norm();
     const double determinant = linear.determinant();
     // Hadamard: |det| <= product of column lengths, with equality for orthogonal columns.
     const double conditioning = column_lengths > 0.0 ? std::abs(determinant) / column_lengths : 0.0;
@@ -52,7 +54,8 @@ Transform Transform::rotate(const Vector3& axis, double radians) {
     require(axis.allFinite() && axis.squaredNorm() > 0.0, "Transform::rotate", "axis",
             "finite and non-zero", axis);
     require_finite(radians, "Transform::rotate", "angle");
-    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(radians, axis.normalized()).toRotationMatrix();
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(radians, axis.normalized()).toRotationMatrix();
     // The inverse of a rotation is its transpose: exact, no solve.
     return Transform(rotation, Vector3::Zero(), rotation.transpose(), Vector3::Zero());
 }

@@ -28,10 +28,13 @@ TYPED_TEST(TriangleSetTest, AnalyticHitWithBarycentrics) {
     EXPECT_FLOAT_EQ(record.v, 0.5f);   // weight of corner 2: y / 4
     EXPECT_EQ(record.primitive, 0u);
     // The interval is closed at both ends and honoured at both.
-    for (auto [t_min, t_max, expected] : {std::tuple{0.0, 2.5, true}, {2.5, 9.0, true},
-                                          {0.0, 2.4999, false}, {2.5001, 9.0, false}}) {
+    for (auto [t_min, t_max, expected] : {std::tuple{0.0, 2.5, true},
+                                          {2.5, 9.0, true},
+                                          {0.0, 2.4999, false},
+                                          {2.5001, 9.0, false}}) {
         const Ray clipped{ray.origin, ray.direction, t_min, t_max};
-        EXPECT_EQ(set.occluded(0, set.prepare(clipped, scratch)), expected) << t_min << " " << t_max;
+        EXPECT_EQ(set.occluded(0, set.prepare(clipped, scratch)), expected)
+            << t_min << " " << t_max;
     }
     EXPECT_FALSE(set.occluded(0, set.prepare(Ray{Point3(3, 3, 5), Vector3(0, 0, -1)}, scratch)));
 }
@@ -80,7 +83,8 @@ TYPED_TEST(TriangleSetTest, ClosedMeshNeverLeaksAtSharedEdgesAndVertices) {
         }
     }
     for (int i = 0; i < 100000; ++i) {
-        const Point3 origin = random.in_box(Aabb(Point3(0.01, 0.01, 0.01), Point3(7.99, 7.99, 7.99)));
+        const Point3 origin =
+            random.in_box(Aabb(Point3(0.01, 0.01, 0.01), Point3(7.99, 7.99, 7.99)));
         expect_hit(origin, random.unit_vector());
     }
     EXPECT_GT(rays, 100000);

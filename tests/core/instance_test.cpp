@@ -40,12 +40,12 @@ TEST(Instance, ScaledShearedSphereMatchesTheEllipsoidSolvedDirectly) {
             Transform::translate(random.unit_vector() * 5) *
             Transform::rotate(random.unit_vector(), random.uniform(0, kTwoPi)) *
             Transform::shear(random.integer(0, 1), 2, random.uniform(-1, 1)) *
-            Transform::scale(Vector3(random.uniform(0.2, 3), random.uniform(0.2, 3),
-                                     random.uniform(0.2, 3)));
+            Transform::scale(
+                Vector3(random.uniform(0.2, 3), random.uniform(0.2, 3), random.uniform(0.2, 3)));
         const Instance ellipsoid(unit_sphere, world_from_object);
         for (int i = 0; i < 1000; ++i) {
-            const Ray ray = random.ray_between(test::enlarged(ellipsoid.bounds(), 1.0),
-                                               ellipsoid.bounds());
+            const Ray ray =
+                random.ray_between(test::enlarged(ellipsoid.bounds(), 1.0), ellipsoid.bounds());
             const std::optional<Hit> hit = ellipsoid.intersect(ray);
             const std::optional<long double> expected =
                 ellipsoid_nearest(world_from_object.linear(), world_from_object.translation(), ray);
@@ -58,8 +58,8 @@ TEST(Instance, ScaledShearedSphereMatchesTheEllipsoidSolvedDirectly) {
             EXPECT_NEAR((hit->point - ray.at(hit->t)).norm(), 0.0, 1e-12 * (1 + ray.origin.norm()));
             // The world normal is the gradient of |L^-1 (p - c)|^2, i.e. L^-T L^-1 (p - c).
             const Eigen::Matrix3d inverse = world_from_object.inverse_linear();
-            const Vector3 gradient = inverse.transpose() * inverse *
-                                     (hit->point - world_from_object.translation());
+            const Vector3 gradient =
+                inverse.transpose() * inverse * (hit->point - world_from_object.translation());
             EXPECT_LT(hit->geometric_normal.cross(gradient.normalized()).norm(), 1e-9);
         }
     }
@@ -95,9 +95,12 @@ TEST(Instance, PropertiesOnRandomRays) {
         object_from_world.linear().transpose() * object_from_world.linear();
     const test::SurfaceDescription surface{
         [&](const Point3& p) { return object_from_world.apply_point(p).squaredNorm() - 1.0; },
-        [&](const Point3& p) { return Vector3(2.0 * gradient_map * (p - world_from_object.translation())); },
+        [&](const Point3& p) {
+            return Vector3(2.0 * gradient_map * (p - world_from_object.translation()));
+        },
         1.0, ellipsoid.bounds()};
-    const test::PropertyCounts counts = test::check_shape_properties(ellipsoid, surface, 100000, 22);
+    const test::PropertyCounts counts =
+        test::check_shape_properties(ellipsoid, surface, 100000, 22);
     EXPECT_GT(counts.hits, 25000);
 }
 

@@ -64,12 +64,11 @@ TEST(Sphere, IntervalHonouredAtBothEnds) {
 
 TEST(Sphere, InvalidRaysNeverHit) {
     const double nan = std::nan("");
-    for (const Ray& ray : {Ray{Point3(nan, 0, -5), Vector3(0, 0, 1)},
-                           Ray{Point3(0, 0, -5), Vector3(0, nan, 1)},
-                           Ray{Point3(0, 0, -5), Vector3(0, 0, 0)},
-                           Ray{Point3(0, 0, -kInfinity), Vector3(0, 0, 1)},
-                           Ray{Point3(0, 0, -5), Vector3(0, 0, 1), nan, kInfinity},
-                           Ray{Point3(0, 0, -5), Vector3(0, 0, 1), 5.0, 4.0}}) {
+    for (const Ray& ray :
+         {Ray{Point3(nan, 0, -5), Vector3(0, 0, 1)}, Ray{Point3(0, 0, -5), Vector3(0, nan, 1)},
+          Ray{Point3(0, 0, -5), Vector3(0, 0, 0)}, Ray{Point3(0, 0, -kInfinity), Vector3(0, 0, 1)},
+          Ray{Point3(0, 0, -5), Vector3(0, 0, 1), nan, kInfinity},
+          Ray{Point3(0, 0, -5), Vector3(0, 0, 1), 5.0, 4.0}}) {
         EXPECT_FALSE(kUnitSphere.intersect(ray));
         EXPECT_FALSE(kUnitSphere.occluded(ray));
         EXPECT_TRUE(kUnitSphere.spans(ray).empty());
@@ -96,7 +95,9 @@ TEST(Sphere, UvFollowsTheBookConvention) {
 TEST(Sphere, PropertiesOnRandomRays) {
     const Sphere sphere(Point3(0.3, -1.2, 2.0), 1.7);
     const test::SurfaceDescription surface{
-        [&](const Point3& p) { return (p - sphere.center()).squaredNorm() - square(sphere.radius()); },
+        [&](const Point3& p) {
+            return (p - sphere.center()).squaredNorm() - square(sphere.radius());
+        },
         [&](const Point3& p) { return Vector3(2.0 * (p - sphere.center())); }, sphere.radius(),
         sphere.bounds()};
     const test::PropertyCounts counts = test::check_shape_properties(sphere, surface, 100000, 11);

@@ -15,13 +15,16 @@ namespace {
 constexpr double kTolerance = 1e-12;
 
 TEST(Transform, ElementaryMapsAnalytic) {
-    EXPECT_TRUE(Transform::translate(Vector3(1, 2, 3)).apply_point(Point3(1, 1, 1))
+    EXPECT_TRUE(Transform::translate(Vector3(1, 2, 3))
+                    .apply_point(Point3(1, 1, 1))
                     .isApprox(Point3(2, 3, 4)));
-    EXPECT_TRUE(Transform::translate(Vector3(1, 2, 3)).apply_vector(Vector3(1, 1, 1))
+    EXPECT_TRUE(Transform::translate(Vector3(1, 2, 3))
+                    .apply_vector(Vector3(1, 1, 1))
                     .isApprox(Vector3(1, 1, 1)));
-    EXPECT_TRUE(Transform::scale(Vector3(2, 3, 4)).apply_point(Point3(1, 1, 1))
-                    .isApprox(Point3(2, 3, 4)));
-    const Point3 rotated = Transform::rotate(Vector3(0, 0, 1), kPi / 2).apply_point(Point3(1, 0, 0));
+    EXPECT_TRUE(
+        Transform::scale(Vector3(2, 3, 4)).apply_point(Point3(1, 1, 1)).isApprox(Point3(2, 3, 4)));
+    const Point3 rotated =
+        Transform::rotate(Vector3(0, 0, 1), kPi / 2).apply_point(Point3(1, 0, 0));
     EXPECT_NEAR((rotated - Point3(0, 1, 0)).norm(), 0.0, kTolerance);
     EXPECT_TRUE(Transform::shear(0, 1, 2.0).apply_point(Point3(1, 1, 0)).isApprox(Point3(3, 1, 0)));
 }
@@ -56,8 +59,8 @@ TEST(Transform, CompositionAndCachedInverse) {
 }
 
 TEST(Transform, RayParameterIsPreserved) {
-    const Transform m = Transform::translate(Vector3(1, -2, 5)) * Transform::scale(Vector3(3, 0.5, 2)) *
-                        Transform::shear(2, 0, 1.5);
+    const Transform m = Transform::translate(Vector3(1, -2, 5)) *
+                        Transform::scale(Vector3(3, 0.5, 2)) * Transform::shear(2, 0, 1.5);
     const Ray ray{Point3(0.3, 0.2, -1), Vector3(0.1, 0.7, 0.4), 0.25, 7.5};
     const Ray mapped = m.apply(ray);
     EXPECT_EQ(mapped.t_min, ray.t_min);
@@ -79,7 +82,8 @@ TEST(Transform, BoxBoundsEveryMappedCorner) {
             const Point3 p((corner & 1) ? box.upper.x() : box.lower.x(),
                            (corner & 2) ? box.upper.y() : box.lower.y(),
                            (corner & 4) ? box.upper.z() : box.lower.z());
-            EXPECT_TRUE(mapped.contains(m.apply_point(p))) << "transform " << i << " corner " << corner;
+            EXPECT_TRUE(mapped.contains(m.apply_point(p)))
+                << "transform " << i << " corner " << corner;
         }
     }
     EXPECT_TRUE(Transform::rotate(Vector3(1, 0, 0), 1.0).apply(Aabb::empty()).is_empty());

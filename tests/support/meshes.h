@@ -23,7 +23,8 @@ inline TestMesh integer_cube(int n) {
     std::map<std::array<int, 3>, std::uint32_t> index_of;
     auto vertex = [&](int x, int y, int z) {
         const std::array<int, 3> key{x, y, z};
-        auto [it, inserted] = index_of.emplace(key, static_cast<std::uint32_t>(mesh.vertices.size()));
+        auto [it, inserted] =
+            index_of.emplace(key, static_cast<std::uint32_t>(mesh.vertices.size()));
         if (inserted) mesh.vertices.emplace_back(x, y, z);
         return it->second;
     };

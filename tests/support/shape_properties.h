@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <functional>
 #include <string>
@@ -12,8 +14,8 @@
 namespace csgrt::test {
 
 /// An independent description of a shape's surface for property tests: an implicit function
-/// that is zero on the surface, and its gradient. For part objects, `on_surface` may further
-/// restrict where a hit may lie.
+/// that is zero on the surface, and its gradient. (Part objects check their limits in their
+/// own tests.)
 struct SurfaceDescription {
     std::function<double(const Point3&)> value;
     std::function<Vector3(const Point3&)> gradient;
@@ -80,7 +82,8 @@ inline PropertyCounts check_shape_properties(const Shape& shape, const SurfaceDe
         const SpanList spans = shape.spans(ray);
         double first = kInfinity;
         for (const Span& span : spans) {
-            if (span.enter.shape && ray.in_range(span.enter.t)) first = std::min(first, span.enter.t);
+            if (span.enter.shape && ray.in_range(span.enter.t))
+                first = std::min(first, span.enter.t);
             if (span.exit.shape && ray.in_range(span.exit.t)) first = std::min(first, span.exit.t);
         }
         if (hit) {
@@ -93,7 +96,8 @@ inline PropertyCounts check_shape_properties(const Shape& shape, const SurfaceDe
         // Point membership at sample points along the ray, away from span boundaries.
         const double margin = 1e-6 * surface.scale / ray.direction.norm();
         for (int sample = 0; sample < 4; ++sample) {
-            const double t = random.uniform(0.0, 3.0 * (from.diagonal().norm() / ray.direction.norm()));
+            const double t =
+                random.uniform(0.0, 3.0 * (from.diagonal().norm() / ray.direction.norm()));
             bool inside = false;
             bool near_boundary = false;
             for (const Span& span : spans) {

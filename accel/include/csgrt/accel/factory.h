@@ -6,6 +6,7 @@
 
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/brute_force.h"
+#include "csgrt/accel/bvh.h"
 #include "csgrt/accel/ray_classification.h"
 
 namespace csgrt {
@@ -14,6 +15,7 @@ namespace csgrt {
 struct AcceleratorConfig {
     BruteForceConfig brute_force;
     RayClassificationConfig ray_classification;
+    BvhConfig bvh;
 };
 
 /// The names `make_accelerator` accepts, in the order the benchmark reports them.

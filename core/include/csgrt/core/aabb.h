@@ -59,9 +59,9 @@ struct Aabb {
     /// Slab test (Kay & Kajiya 1986) made conservative as in Ize, "Robust BVH Ray Traversal",
     /// JCGT 2(2) 2013: t_far is moved out by 2 gamma(3) |t_far|, which covers the rounding of
     /// the subtraction and product in both slab distances, so a ray that grazes the box is
-    /// never culled (|t_far| rather than t_far keeps it conservative for t < 0 too). A zero direction
-    /// component gives an infinite reciprocal; the NaN from 0 * inf (origin on a slab plane) is
-    /// ignored by the comparisons, which keeps the test conservative. On a hit, [t_enter,
+    /// never culled (|t_far| rather than t_far keeps it conservative for t < 0 too). A zero
+    /// direction component gives an infinite reciprocal; the NaN from 0 * inf (origin on a slab
+    /// plane) is ignored by the comparisons, which keeps the test conservative. On a hit, [t_enter,
     /// t_exit] overlaps [ray.t_min, ray.t_max] and is clipped to it.
     bool intersect(const Ray& ray, const Vector3& inverse_direction, double& t_enter,
                    double& t_exit) const {

@@ -23,9 +23,8 @@ struct Ray {
 /// with t_min <= t_max (t_max may be +infinity, t_min may be -infinity). Queries given any
 /// other ray report no hit.
 inline bool is_valid(const Ray& ray) {
-    return is_finite(ray.origin) && is_finite(ray.direction) &&
-           ray.direction.squaredNorm() > 0.0 && ray.t_min <= ray.t_max &&
-           !std::isnan(ray.t_min) && !std::isnan(ray.t_max);
+    return is_finite(ray.origin) && is_finite(ray.direction) && ray.direction.squaredNorm() > 0.0 &&
+           ray.t_min <= ray.t_max && !std::isnan(ray.t_min) && !std::isnan(ray.t_max);
 }
 
 }  // namespace csgrt

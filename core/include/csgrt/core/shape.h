@@ -50,8 +50,11 @@ public:
 
     /// For solids: replaces `spans` with the intervals along the ray's whole line where it is
     /// inside the solid, keeping every interval that overlaps [t_min, t_max] (and possibly
-    /// others). Ends are not clipped to the ray's interval. The first span boundary in
-    /// [t_min, t_max] is the hit `nearest_hit` reports. Non-solids leave `spans` empty.
+    /// others). Ends are not clipped to the ray's interval. Ends inside it are exact; an end
+    /// outside it lies on the correct side but may be an operand's end rather than the true
+    /// surface (CSG nodes combine operands that omit spans outside the interval). The first
+    /// span boundary in [t_min, t_max] is the hit `nearest_hit` reports. Non-solids leave
+    /// `spans` empty.
     virtual void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const;
 
     /// For solids: whether point p (in the shape's space) is inside. Points on the surface

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "csgrt/accel/triangle_set.h"
+#include "csgrt/core/ray.h"
+
+namespace csgrt {
+
+/// The exact reference for triangle meshes: CGAL's AABB tree over the same (rounded) triangles
+/// as a TriangleSet, queried with the Exact_predicates_inexact_constructions_kernel. Whether a
+/// ray hits a triangle is decided by exact predicates (CGAL::do_intersect); the nearest hit is
+/// taken among the triangles exact predicates say are hit, with t computed in long double from
+/// the triangle's plane (CGAL's own first_intersection constructs points inexactly). The only
+/// CGAL code in csgrt lives behind this class, so CGAL's compile cost stays in one file.
+class CgalReference {
+public:
+    struct Answer {
+        double t = 0.0;
+        std::uint32_t primitive = kNoIndex;
+    };
+
+    /// Builds the tree over the corners stored in `set` (so float sets are judged on their
+    /// rounded vertices, not the file's).
+    template <class Real>
+    explicit CgalReference(const TriangleSet<Real>& set);
+    ~CgalReference();
+    CgalReference(CgalReference&&) noexcept;
+    CgalReference& operator=(CgalReference&&) noexcept;
+
+    /// Exact: does the ray (t in [t_min, t_max]) touch any triangle? For t_min = 0 and
+    /// t_max = inf the query is a CGAL ray; otherwise a segment between the rounded end points.
+    bool do_intersect(const Ray& ray) const;
+    /// Every triangle the ray touches, decided exactly, in increasing index order.
+    std::vector<std::uint32_t> intersected_primitives(const Ray& ray) const;
+    /// The nearest of the exactly-hit triangles; ties in t go to the lower index.
+    std::optional<Answer> nearest(const Ray& ray) const;
+    /// CGAL's own nearest query (AABB_tree::first_intersected_primitive): the speed peer in the
+    /// benchmark. Not exact: it orders hits by inexactly constructed points.
+    std::optional<std::uint32_t> first_intersected_primitive(const Ray& ray) const;
+
+    std::size_t size() const;
+    /// Parameter t of the ray's line at the plane of triangle `primitive`, in long double.
+    long double plane_t(const Ray& ray, std::uint32_t primitive) const;
+
+private:
+    struct Tree;
+    std::unique_ptr<Tree> tree_;
+    std::vector<std::array<Eigen::Vector3d, 3>> corners_;
+};
+
+}  // namespace csgrt

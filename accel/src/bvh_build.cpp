@@ -1,0 +1,489 @@
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <limits>
+
+#include "bvh_simd.h"
+#include "csgrt/accel/bvh_build.h"
+
+namespace csgrt::detail {
+
+namespace {
+
+constexpr float kInfinityFloat = std::numeric_limits<float>::infinity();
+constexpr int kMaxBins = 256;
+/// Below these sizes a subtree is built, or a node binned, on one thread: smaller tasks cost
+/// more to schedule than they save.
+constexpr std::uint32_t kParallelSubtree = 4096;
+constexpr std::uint32_t kParallelBinning = 1u << 16;
+
+/// A float box in two SIMD registers (the fourth lane is unused).
+struct Box {
+    Float4 lower;
+    Float4 upper;
+
+    static Box empty() {
+        return {Float4::broadcast(kInfinityFloat), Float4::broadcast(-kInfinityFloat)};
+    }
+    static Box of(const BuildPrimitive& p) {
+        return {Float4::load(p.lower), Float4::load(p.upper)};
+    }
+    // The new value is the first operand: a NaN in it (the centre of an unbounded box) is
+    // ignored rather than spread.
+    void extend(const Box& box) {
+        lower = min(box.lower, lower);
+        upper = max(box.upper, upper);
+    }
+    void extend(Float4 point) {
+        lower = min(point, lower);
+        upper = max(point, upper);
+    }
+    void store(float* low, float* high) const {
+        float l[4], h[4];
+        lower.store(l);
+        upper.store(h);
+        std::copy_n(l, 3, low);
+        std::copy_n(h, 3, high);
+    }
+    /// Half the surface area, in double so that large boxes do not overflow; the SAH only
+    /// uses ratios of areas.
+    double half_area() const {
+        float l[4], h[4];
+        lower.store(l);
+        upper.store(h);
+        if (!(l[0] <= h[0] && l[1] <= h[1] && l[2] <= h[2])) return 0.0;
+        const double x = double(h[0]) - l[0], y = double(h[1]) - l[1], z = double(h[2]) - l[2];
+        return x * y + y * z + z * x;
+    }
+};
+
+/// Twice the centre of a primitive's box: binning only needs it up to scale.
+Float4 doubled_centroid(const BuildPrimitive& p) {
+    return Float4::load(p.lower) + Float4::load(p.upper);
+}
+
+/// A range of primitives with its box and the box of its (doubled) centroids.
+struct Range {
+    std::uint32_t begin, end;
+    Box box;
+    Box centroids;
+};
+
+/// Maps doubled centroids to bins, on all three axes at once. The same arithmetic is used when
+/// binning and when partitioning, so both agree on every primitive.
+struct BinMapping {
+    Float4 origin, scale, last;
+    float scales[4];
+
+    BinMapping(const Box& centroids, int bin_count) {
+        float l[4], h[4];
+        centroids.lower.store(l);
+        centroids.upper.store(h);
+        for (int axis = 0; axis < 3; ++axis) {
+            // A zero, infinite or denormal extent gives a useless or non-finite scale: such
+            // an axis is not binned.
+            const float extent = h[axis] - l[axis];
+            const float s = float(bin_count) / extent;
+            scales[axis] = extent > 0.0f && std::isfinite(s) && s > 0.0f ? s : 0.0f;
+            if (!std::isfinite(l[axis])) l[axis] = 0.0f;
+        }
+        l[3] = 0.0f;
+        scales[3] = 0.0f;
+        origin = Float4::load(l);
+        scale = Float4::load(scales);
+        last = Float4::broadcast(float(bin_count - 1));
+    }
+    /// The bins of a primitive on the three axes (and a fourth, unused).
+    void bins(const BuildPrimitive& p, int* out) const {
+        // max(x, 0) returns 0 for NaN (the centre of an unbounded box) and min clamps to the
+        // last bin, so the truncation always sees a value in [0, bins - 1].
+        const Float4 position = (doubled_centroid(p) - origin) * scale;
+        min(max(position, Float4::broadcast(0.0f)), last).truncate(out);
+    }
+};
+
+struct Bins {
+    Box boxes[3][kMaxBins];
+    std::uint32_t counts[3][kMaxBins];
+    int bin_count;
+
+    /// Only the first `bin_count` bins of each axis are used (and initialised).
+    explicit Bins(int n) : bin_count(n) {
+        for (int axis = 0; axis < 3; ++axis) {
+            std::fill_n(boxes[axis], n, Box::empty());
+            std::fill_n(counts[axis], n, 0u);
+        }
+    }
+    void add(const BinMapping& mapping, const BuildPrimitive& primitive) {
+        alignas(16) int bin[4];
+        mapping.bins(primitive, bin);
+        const Box box = Box::of(primitive);
+        for (int axis = 0; axis < 3; ++axis) {
+            boxes[axis][bin[axis]].extend(box);
+            ++counts[axis][bin[axis]];
+        }
+    }
+    void join(const Bins& other) {
+        for (int axis = 0; axis < 3; ++axis) {
+            for (int b = 0; b < bin_count; ++b) {
+                boxes[axis][b].extend(other.boxes[axis][b]);
+                counts[axis][b] += other.counts[axis][b];
+            }
+        }
+    }
+};
+
+struct Split {
+    int axis = -1;
+    /// Bins 0 .. bin go left.
+    int bin = 0;
+    /// Sum over both sides of half area times primitive count.
+    double cost = std::numeric_limits<double>::infinity();
+};
+
+class Builder {
+public:
+    Builder(std::span<BuildPrimitive> primitives, const BvhConfig& config, BinaryBvh& tree)
+        : primitives_(primitives), config_(config), tree_(tree) {}
+
+    /// The box and centroid box of all primitives, for the root.
+    Range root() const {
+        Range range{0, static_cast<std::uint32_t>(primitives_.size()), Box::empty(), Box::empty()};
+        for (const BuildPrimitive& p : primitives_) {
+            range.box.extend(Box::of(p));
+            range.centroids.extend(doubled_centroid(p));
+        }
+        return range;
+    }
+
+    /// Builds the subtree of `range` into node `node`; returns its depth.
+    int build(std::uint32_t node, const Range& range, int depth) {
+        const std::uint32_t count = range.end - range.begin;
+        BvhNode& target = tree_.nodes[node];
+        range.box.store(target.lower, target.upper);
+
+        Range left, right;
+        bool split = false;
+        if (count == 2 && depth < kMaxSahDepth && !coincident(range.centroids)) {
+            // Two primitives allow one split, whose SAH cost needs no bins: this is the most
+            // common node near the leaves.
+            const BuildPrimitive* pair = primitives_.data() + range.begin;
+            const Box a = Box::of(pair[0]), b = Box::of(pair[1]);
+            const double split_cost = config_.traversal_cost + config_.intersection_cost *
+                                                                   (a.half_area() + b.half_area()) /
+                                                                   range.box.half_area();
+            if (split_cost < 2.0 * config_.intersection_cost || config_.max_leaf_size < 2) {
+                left = {range.begin, range.begin + 1, a, Box::empty()};
+                right = {range.begin + 1, range.end, b, Box::empty()};
+                left.centroids.extend(doubled_centroid(pair[0]));
+                right.centroids.extend(doubled_centroid(pair[1]));
+                split = true;
+            }
+        } else if (count > 1 && depth < kMaxSahDepth) {
+            const int bin_count = bins_for(count);
+            const BinMapping mapping(range.centroids, bin_count);
+            const Split best = find_split(range, mapping, bin_count);
+            const double leaf_cost = config_.intersection_cost * count;
+            const double split_cost = config_.traversal_cost +
+                                      config_.intersection_cost * best.cost / range.box.half_area();
+            const bool split_pays = best.axis >= 0 && split_cost < leaf_cost;
+            if (best.axis >= 0 && (split_pays || count > std::uint32_t(config_.max_leaf_size))) {
+                partition(range, mapping, best, left, right);
+                split = true;
+            }
+        }
+        if (!split && count > std::uint32_t(config_.max_leaf_size)) {
+            median_split(range, left, right);
+            split = true;
+        }
+        if (!split) {
+            target.offset = range.begin;
+            target.count = count;
+            leaves_.fetch_add(1, std::memory_order_relaxed);
+            return 0;
+        }
+
+        const std::uint32_t first = next_node_.fetch_add(2, std::memory_order_relaxed);
+        target.offset = first;
+        target.count = 0;
+        int left_depth = 0, right_depth = 0;
+        if (config_.parallel && count > kParallelSubtree) {
+            tbb::parallel_invoke([&] { left_depth = build(first, left, depth + 1); },
+                                 [&] { right_depth = build(first + 1, right, depth + 1); });
+        } else {
+            left_depth = build(first, left, depth + 1);
+            right_depth = build(first + 1, right, depth + 1);
+        }
+        return 1 + std::max(left_depth, right_depth);
+    }
+
+    std::uint32_t node_count() const { return next_node_.load(); }
+    std::size_t leaf_count() const { return leaves_.load(); }
+
+private:
+    /// Whether all centroids are one point (no split by centroid can separate them).
+    static bool coincident(const Box& centroids) {
+        float l[4], h[4];
+        centroids.lower.store(l);
+        centroids.upper.store(h);
+        return !(l[0] < h[0] || l[1] < h[1] || l[2] < h[2]);
+    }
+
+    /// Small nodes get fewer bins: the sweep over the bins would otherwise cost more than
+    /// binning their few primitives, and with a handful of centroids more bins add nothing.
+    int bins_for(std::uint32_t count) const {
+        return static_cast<int>(std::min<std::uint32_t>(config_.bins, std::max(4u, count)));
+    }
+
+    /// The cheapest binned split over all three axes (axis -1 when the centroids coincide).
+    Split find_split(const Range& range, const BinMapping& mapping, int bin_count) const {
+        Bins bins(bin_count);
+        if (!config_.parallel || range.end - range.begin < kParallelBinning) {
+            for (std::uint32_t i = range.begin; i != range.end; ++i)
+                bins.add(mapping, primitives_[i]);
+        } else {
+            // Each task bins a chunk into its own bins; the results are summed.
+            struct Body {
+                const Builder& builder;
+                const BinMapping& mapping;
+                Bins bins;
+                Body(const Builder& b, const BinMapping& m, int n)
+                    : builder(b), mapping(m), bins(n) {}
+                Body(Body& other, tbb::split)
+                    : builder(other.builder), mapping(other.mapping), bins(other.bins.bin_count) {}
+                void operator()(const tbb::blocked_range<std::uint32_t>& chunk) {
+                    for (std::uint32_t i = chunk.begin(); i != chunk.end(); ++i)
+                        bins.add(mapping, builder.primitives_[i]);
+                }
+                void join(const Body& other) { bins.join(other.bins); }
+            };
+            Body body(*this, mapping, bin_count);
+            tbb::parallel_reduce(
+                tbb::blocked_range<std::uint32_t>(range.begin, range.end, 1u << 14), body);
+            bins = body.bins;
+        }
+
+        Split best;
+        double right_cost[kMaxBins];
+        for (int axis = 0; axis < 3; ++axis) {
+            if (mapping.scales[axis] == 0.0f) continue;
+            // Sweep from the right, then from the left: the cost of splitting after bin b is
+            // area(left) count(left) + area(right) count(right).
+            Box right = Box::empty();
+            std::uint32_t right_count = 0;
+            for (int b = bin_count - 1; b > 0; --b) {
+                right.extend(bins.boxes[axis][b]);
+                right_count += bins.counts[axis][b];
+                right_cost[b] = right_count ? right.half_area() * right_count : -1.0;
+            }
+            Box left = Box::empty();
+            std::uint32_t left_count = 0;
+            for (int b = 0; b < bin_count - 1; ++b) {
+                left.extend(bins.boxes[axis][b]);
+                left_count += bins.counts[axis][b];
+                if (left_count == 0 || right_cost[b + 1] < 0.0) continue;
+                const double cost = left.half_area() * left_count + right_cost[b + 1];
+                if (cost < best.cost) best = Split{axis, b, cost};
+            }
+        }
+        return best;
+    }
+
+    /// Moves the primitives of bins 0 .. split.bin to the front of the range, computing both
+    /// sides' boxes on the way.
+    void partition(const Range& range, const BinMapping& mapping, const Split& split, Range& left,
+                   Range& right) {
+        auto goes_left = [&](const BuildPrimitive& p) {
+            alignas(16) int bin[4];
+            mapping.bins(p, bin);
+            return bin[split.axis] <= split.bin;
+        };
+        left = {range.begin, range.begin, Box::empty(), Box::empty()};
+        right = {range.end, range.end, Box::empty(), Box::empty()};
+        BuildPrimitive* i = primitives_.data() + range.begin;
+        BuildPrimitive* j = primitives_.data() + range.end;
+        for (;;) {
+            while (i != j && goes_left(*i)) {
+                left.box.extend(Box::of(*i));
+                left.centroids.extend(doubled_centroid(*i));
+                ++i;
+            }
+            while (i != j && !goes_left(*(j - 1))) {
+                --j;
+                right.box.extend(Box::of(*j));
+                right.centroids.extend(doubled_centroid(*j));
+            }
+            if (i == j) break;
+            // *i belongs right and *(j - 1) left: exchange them and count both.
+            --j;
+            std::swap(*i, *j);
+            left.box.extend(Box::of(*i));
+            left.centroids.extend(doubled_centroid(*i));
+            ++i;
+            right.box.extend(Box::of(*j));
+            right.centroids.extend(doubled_centroid(*j));
+        }
+        left.end = right.begin = static_cast<std::uint32_t>(i - primitives_.data());
+    }
+
+    /// Splits the range in half by centroid along the longest centroid axis, ties (and
+    /// coincident centroids) broken by primitive index so the halves are reproducible.
+    void median_split(const Range& range, Range& left, Range& right) {
+        float l[4], h[4];
+        range.centroids.lower.store(l);
+        range.centroids.upper.store(h);
+        int axis = 0;
+        float longest = -1.0f;
+        for (int a = 0; a < 3; ++a) {
+            const float extent = h[a] - l[a];
+            if (extent > longest) longest = extent, axis = a;
+        }
+        auto key = [axis](const BuildPrimitive& p) {
+            const float c = p.lower[axis] + p.upper[axis];
+            return std::isnan(c) ? 0.0f : c;
+        };
+        const std::uint32_t middle = range.begin + (range.end - range.begin) / 2;
+        std::nth_element(primitives_.begin() + range.begin, primitives_.begin() + middle,
+                         primitives_.begin() + range.end,
+                         [&](const BuildPrimitive& a, const BuildPrimitive& b) {
+                             const float ka = key(a), kb = key(b);
+                             return ka != kb ? ka < kb : a.index < b.index;
+                         });
+        left = {range.begin, middle, Box::empty(), Box::empty()};
+        right = {middle, range.end, Box::empty(), Box::empty()};
+        for (Range* side : {&left, &right}) {
+            for (std::uint32_t k = side->begin; k != side->end; ++k) {
+                side->box.extend(Box::of(primitives_[k]));
+                side->centroids.extend(doubled_centroid(primitives_[k]));
+            }
+        }
+    }
+
+    std::span<BuildPrimitive> primitives_;
+    const BvhConfig& config_;
+    BinaryBvh& tree_;
+    /// Node 0 is the root and node 1 is unused, so sibling pairs start at even indices.
+    std::atomic<std::uint32_t> next_node_{2};
+    std::atomic<std::size_t> leaves_{0};
+};
+
+double node_half_area(const BvhNode& node) {
+    const float lower[4] = {node.lower[0], node.lower[1], node.lower[2], 0.0f};
+    const float upper[4] = {node.upper[0], node.upper[1], node.upper[2], 0.0f};
+    return Box{Float4::load(lower), Float4::load(upper)}.half_area();
+}
+
+double sah_cost(const BinaryBvh& tree, const BvhConfig& config) {
+    auto half_area = [](const BvhNode& node) { return node_half_area(node); };
+    double total = 0.0;
+    for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+        if (i == 1) continue;
+        const BvhNode& node = tree.nodes[i];
+        total += half_area(node) *
+                 (node.is_leaf() ? config.intersection_cost * node.count : config.traversal_cost);
+    }
+    const double root_area = half_area(tree.nodes[0]);
+    return root_area > 0.0 ? total / root_area : 0.0;
+}
+
+/// Appends the wide node that replaces binary node `index` and, depth first, its subtree;
+/// returns the new node's index.
+template <int kWidth>
+std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
+                            std::vector<WideBvhNode<kWidth>>& wide) {
+    using Node = WideBvhNode<kWidth>;
+    const auto& nodes = binary.nodes;
+    std::array<std::uint32_t, kWidth> children{};
+    int child_count = 0;
+    if (nodes[index].is_leaf()) {
+        children[child_count++] = index;  // a lone leaf at the root
+    } else {
+        children[child_count++] = nodes[index].offset;
+        children[child_count++] = nodes[index].offset + 1;
+    }
+    // Open the interior child with the largest box until there are kWidth: it is the one a
+    // random ray is most likely to enter, so adopting its children saves the most visits.
+    while (child_count < kWidth) {
+        int widest = -1;
+        double widest_area = -1.0;
+        for (int i = 0; i < child_count; ++i) {
+            const BvhNode& child = nodes[children[i]];
+            if (child.is_leaf()) continue;
+            const double area = node_half_area(child);
+            if (area > widest_area) widest_area = area, widest = i;
+        }
+        if (widest < 0) break;
+        const std::uint32_t opened = children[widest];
+        children[widest] = nodes[opened].offset;
+        children[child_count++] = nodes[opened].offset + 1;
+    }
+
+    const auto wide_index = static_cast<std::uint32_t>(wide.size());
+    wide.emplace_back();
+    for (int slot = 0; slot < kWidth; ++slot) {
+        Node& node = wide[wide_index];
+        if (slot >= child_count) {
+            for (int axis = 0; axis < 3; ++axis) {
+                node.bounds[2 * axis][slot] = kInfinityFloat;
+                node.bounds[2 * axis + 1][slot] = -kInfinityFloat;
+            }
+            node.first[slot] = 0;
+            node.count[slot] = 0;
+            continue;
+        }
+        const BvhNode& child = nodes[children[slot]];
+        for (int axis = 0; axis < 3; ++axis) {
+            node.bounds[2 * axis][slot] = child.lower[axis];
+            node.bounds[2 * axis + 1][slot] = child.upper[axis];
+        }
+        if (child.is_leaf()) {
+            node.first[slot] = child.count == 1 ? binary.indices[child.offset] : child.offset;
+            node.count[slot] = child.count;
+        } else {
+            node.count[slot] = Node::kInterior;
+            // The recursion may grow `wide`, so the node is looked up again afterwards.
+            const std::uint32_t first = collapse_node(binary, children[slot], wide);
+            wide[wide_index].first[slot] = first;
+        }
+    }
+    return wide_index;
+}
+
+}  // namespace
+
+template <int kWidth>
+std::vector<WideBvhNode<kWidth>> collapse_to_wide(const BinaryBvh& binary) {
+    std::vector<WideBvhNode<kWidth>> wide;
+    if (binary.nodes.empty()) return wide;
+    wide.reserve(binary.nodes.size() / 2 + 1);
+    collapse_node<kWidth>(binary, 0, wide);
+    wide.shrink_to_fit();
+    return wide;
+}
+
+template std::vector<Bvh4Node> collapse_to_wide<4>(const BinaryBvh&);
+template std::vector<Bvh8Node> collapse_to_wide<8>(const BinaryBvh&);
+
+BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config) {
+    BinaryBvh tree;
+    if (primitives.empty()) return tree;
+    // A binary tree over n primitives has at most n - 1 interior nodes, so 2 n slots hold the
+    // root, the unused slot and every sibling pair.
+    tree.nodes.resize(2 * primitives.size());
+    Builder builder(primitives, config, tree);
+    tree.depth = builder.build(0, builder.root(), 0);
+    tree.nodes.resize(primitives.size() == 1 ? 1 : builder.node_count());
+    tree.nodes.shrink_to_fit();
+    tree.leaves = builder.leaf_count();
+    tree.indices.resize(primitives.size());
+    for (std::size_t i = 0; i < primitives.size(); ++i) tree.indices[i] = primitives[i].index;
+    tree.sah_cost = sah_cost(tree, config);
+    return tree;
+}
+
+}  // namespace csgrt::detail

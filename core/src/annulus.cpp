@@ -1,0 +1,72 @@
+#include "csgrt/core/annulus.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "csgrt/core/error.h"
+
+namespace csgrt {
+
+Annulus::Annulus(const Point3& center, const Normal3& normal, double inner_radius,
+                 double outer_radius, double phi_min, double phi_max)
+    : center_(center),
+      inner_radius_(inner_radius),
+      outer_radius_(outer_radius),
+      azimuth_(phi_min, phi_max, "Annulus") {
+    require_finite(center, "Annulus", "center");
+    require_finite(normal, "Annulus", "normal");
+    const Normal3 unit = detail::normalized_or_zero(normal);
+    require(unit.squaredNorm() > 0.0, "Annulus", "normal", "non-zero", normal);
+    require_positive(outer_radius, "Annulus", "outer_radius");
+    require(inner_radius >= 0.0 && inner_radius < outer_radius, "Annulus", "inner_radius",
+            "in [0, outer_radius)", inner_radius);
+    frame_ = SurfaceFrame::around(unit);
+}
+
+Aabb Annulus::bounds() const {
+    return detail::disk_bounds(center_, frame_.normal, outer_radius_);
+}
+
+bool Annulus::crossing(const Ray& ray, double& t) const {
+    if (!detail::plane_crossing(ray, center_, frame_.normal, t) || !ray.in_range(t)) return false;
+    // Squared distances against squared radii, as for the disk: no square root.
+    const Vector3 offset = (ray.origin - center_) + t * ray.direction;
+    const double squared = offset.squaredNorm();
+    if (squared > outer_radius_ * outer_radius_ || squared < inner_radius_ * inner_radius_)
+        return false;
+    return azimuth_.is_full() ||
+           azimuth_.contains(offset.dot(frame_.x_axis), offset.dot(frame_.z_axis));
+}
+
+bool Annulus::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+    double t;
+    if (!crossing(ray, t)) return false;
+    record = HitRecord{.t = t, .shape = this, .primitive = 0};
+    return true;
+}
+
+bool Annulus::any_hit(const Ray& ray, QueryScratch&) const {
+    double t;
+    return crossing(ray, t);
+}
+
+Hit Annulus::finish(const Ray& ray, const HitRecord& record) const {
+    Hit hit;
+    hit.t = record.t;
+    const Vector3 offset = (ray.origin - center_) + record.t * ray.direction;
+    const Vector3 local = frame_.to_local(offset);
+    // Back onto the plane: drop the normal component that rounding left.
+    hit.point = center_ + local.x() * frame_.x_axis + local.z() * frame_.z_axis;
+    hit.geometric_normal = frame_.normal;
+    hit.shading_normal = frame_.normal;
+    const double r = std::hypot(local.x(), local.z());
+    const double radial = (r - inner_radius_) / (outer_radius_ - inner_radius_);
+    hit.uv = Vector2(std::clamp(radial, 0.0, 1.0),
+                     azimuth_.fraction(AngleRange::azimuth(local.x(), local.z())));
+    hit.shape = this;
+    hit.primitive_id = record.primitive;
+    hit.front_face = ray.direction.dot(frame_.normal) < 0.0;
+    return hit;
+}
+
+}  // namespace csgrt

@@ -1,0 +1,63 @@
+#include "csgrt/core/disk.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "csgrt/core/error.h"
+
+namespace csgrt {
+
+Disk::Disk(const Point3& center, const Normal3& normal, double radius)
+    : center_(center), radius_(radius) {
+    require_finite(center, "Disk", "center");
+    require_finite(normal, "Disk", "normal");
+    const Normal3 unit = detail::normalized_or_zero(normal);
+    require(unit.squaredNorm() > 0.0, "Disk", "normal", "non-zero", normal);
+    require_positive(radius, "Disk", "radius");
+    frame_ = SurfaceFrame::around(unit);
+}
+
+Aabb Disk::bounds() const {
+    return detail::disk_bounds(center_, frame_.normal, radius_);
+}
+
+bool Disk::crossing(const Ray& ray, double& t) const {
+    if (!detail::plane_crossing(ray, center_, frame_.normal, t) || !ray.in_range(t)) return false;
+    // Compare squared distances: no square root (the point the seed makes). The offset is
+    // formed as (o - c) + t d, which keeps it accurate when o and c are large but close.
+    const Vector3 offset = (ray.origin - center_) + t * ray.direction;
+    return offset.squaredNorm() <= radius_ * radius_;
+}
+
+bool Disk::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+    double t;
+    if (!crossing(ray, t)) return false;
+    record = HitRecord{.t = t, .shape = this, .primitive = 0};
+    return true;
+}
+
+bool Disk::any_hit(const Ray& ray, QueryScratch&) const {
+    double t;
+    return crossing(ray, t);
+}
+
+Hit Disk::finish(const Ray& ray, const HitRecord& record) const {
+    Hit hit;
+    hit.t = record.t;
+    const Vector3 offset = (ray.origin - center_) + record.t * ray.direction;
+    const Vector3 local = frame_.to_local(offset);
+    // Back onto the plane: drop the normal component that rounding left.
+    hit.point = center_ + local.x() * frame_.x_axis + local.z() * frame_.z_axis;
+    hit.geometric_normal = frame_.normal;
+    hit.shading_normal = frame_.normal;
+    double phi = std::atan2(local.x(), local.z());
+    if (phi < 0.0) phi += kTwoPi;
+    const double r = std::hypot(local.x(), local.z());
+    hit.uv = Vector2(std::min(r / radius_, 1.0), std::min(phi / kTwoPi, 1.0));
+    hit.shape = this;
+    hit.primitive_id = record.primitive;
+    hit.front_face = ray.direction.dot(frame_.normal) < 0.0;
+    return hit;
+}
+
+}  // namespace csgrt

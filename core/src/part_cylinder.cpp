@@ -1,0 +1,86 @@
+#include "csgrt/core/part_cylinder.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "csgrt/core/cylinder.h"
+#include "csgrt/core/error.h"
+
+namespace csgrt {
+
+PartCylinder::PartCylinder(double radius, double y_min, double y_max, double phi_min,
+                           double phi_max)
+    : radius_(radius), y_min_(y_min), y_max_(y_max), azimuth_(phi_min, phi_max, "PartCylinder") {
+    require_positive(radius, "PartCylinder", "radius");
+    require_finite(y_min, "PartCylinder", "y_min");
+    require_finite(y_max, "PartCylinder", "y_max");
+    require(y_min < y_max, "PartCylinder", "y_max", "> y_min", y_max);
+
+    // The arc's box: a point of the side is (r sin phi, y, r cos phi).
+    double sin_lo, sin_hi, cos_lo, cos_hi;
+    azimuth_.sine_cosine_bounds(sin_lo, sin_hi, cos_lo, cos_hi);
+    const Aabb arc(Point3(radius_ * sin_lo, y_min_, radius_ * cos_lo),
+                   Point3(radius_ * sin_hi, y_max_, radius_ * cos_hi));
+    // sin and cos are rounded, and hits are accepted on rounded azimuths: pad so the box
+    // holds every point the queries can return.
+    const Vector3 pad(16.0 * kUnitRoundoff * radius_, 0.0, 16.0 * kUnitRoundoff * radius_);
+    bounds_ = Aabb(arc.lower - pad, arc.upper + pad);
+}
+
+bool PartCylinder::nearest(const Ray& ray, double& t) const {
+    const detail::LineInterval side =
+        detail::infinite_cylinder_interval(ray, radius_, Cylinder::kSide);
+    if (side.empty()) return false;
+    const detail::LineInterval slab =
+        detail::slab_interval(ray, y_min_, y_max_, Cylinder::kBottomCap, Cylinder::kTopCap);
+    // Nearest crossing first; one in the removed sector lets the ray on to the far crossing.
+    // Infinite ends (a line along the axis, or lying in the surface) are not crossings.
+    for (const double end : {side.t0, side.t1}) {
+        if (!std::isfinite(end) || !(slab.t0 <= end && end <= slab.t1) || !ray.in_range(end)) {
+            continue;
+        }
+        const Point3 p = ray.at(end);
+        if (azimuth_.contains(p.x(), p.z())) {
+            t = end;
+            return true;
+        }
+    }
+    return false;
+}
+
+bool PartCylinder::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+    double t;
+    if (!nearest(ray, t)) return false;
+    record = HitRecord{.t = t, .shape = this, .primitive = 0};
+    return true;
+}
+
+bool PartCylinder::any_hit(const Ray& ray, QueryScratch&) const {
+    double t;
+    return nearest(ray, t);
+}
+
+Hit PartCylinder::finish(const Ray& ray, const HitRecord& record) const {
+    Hit hit;
+    hit.t = record.t;
+    Point3 p = ray.at(record.t);
+    const double distance = std::hypot(p.x(), p.z());
+    if (distance > 0.0) {
+        // Radial projection onto the side removes the rounding of o + t d along the normal.
+        p.x() *= radius_ / distance;
+        p.z() *= radius_ / distance;
+        hit.geometric_normal = Normal3(p.x(), 0.0, p.z()).normalized();
+    } else {
+        hit.geometric_normal = Normal3(0.0, 0.0, 1.0);
+    }
+    hit.point = p;
+    hit.shading_normal = hit.geometric_normal;
+    hit.uv = Vector2(azimuth_.fraction(AngleRange::azimuth(p.x(), p.z())),
+                     std::clamp((p.y() - y_min_) / (y_max_ - y_min_), 0.0, 1.0));
+    hit.shape = this;
+    hit.primitive_id = record.primitive;
+    hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
+    return hit;
+}
+
+}  // namespace csgrt

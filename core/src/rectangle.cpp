@@ -1,0 +1,85 @@
+#include "csgrt/core/rectangle.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "csgrt/core/error.h"
+#include "csgrt/core/plane.h"
+
+namespace csgrt {
+
+Rectangle::Rectangle(const Point3& corner, const Vector3& edge_a, const Vector3& edge_b)
+    : corner_(corner), edge_a_(edge_a), edge_b_(edge_b) {
+    require_finite(corner, "Rectangle", "corner");
+    require_finite(edge_a, "Rectangle", "edge_a");
+    require_finite(edge_b, "Rectangle", "edge_b");
+    const double scale_a = edge_a.cwiseAbs().maxCoeff(), scale_b = edge_b.cwiseAbs().maxCoeff();
+    require(scale_a > 0.0, "Rectangle", "edge_a", "non-zero", edge_a);
+    require(scale_b > 0.0, "Rectangle", "edge_b", "non-zero", edge_b);
+    // With a = scale_a a' and b = scale_b b' (components <= 1, so nothing under- or
+    // overflows) and m = a' x b': dual_a = (b x m) / (m . m scale_a) and dual_b = (m x a) /
+    // (m . m scale_b) satisfy a . dual_a = b . dual_b = 1 and a . dual_b = b . dual_a = 0.
+    const Vector3 unit_a = edge_a / scale_a, unit_b = edge_b / scale_b;
+    const Vector3 m = unit_a.cross(unit_b);
+    const double m_squared = m.squaredNorm();
+    require(m_squared > 0.0, "Rectangle", "edge_b", "not parallel to edge_a", edge_b);
+    normal_ = detail::normalized_or_zero(m);
+    dual_a_ = unit_b.cross(m) / (m_squared * scale_a);
+    dual_b_ = m.cross(unit_a) / (m_squared * scale_b);
+}
+
+Aabb Rectangle::bounds() const {
+    Aabb box(corner_, corner_ + edge_a_);
+    box.extend(corner_ + edge_b_);
+    box.extend(corner_ + edge_a_ + edge_b_);
+    // Each corner is up to two roundings from the true one: widen by two ulps.
+    for (int axis = 0; axis < 3; ++axis) {
+        box.lower[axis] = next_down(next_down(box.lower[axis]));
+        box.upper[axis] = next_up(next_up(box.upper[axis]));
+    }
+    return box;
+}
+
+bool Rectangle::crossing(const Ray& ray, double& t, double& s, double& r) const {
+    if (!detail::plane_crossing(ray, corner_, normal_, t) || !ray.in_range(t)) return false;
+    const Vector3 offset = (ray.origin - corner_) + t * ray.direction;
+    s = offset.dot(dual_a_);
+    r = offset.dot(dual_b_);
+    // Closed: edges and corners belong to the parallelogram.
+    return s >= 0.0 && s <= 1.0 && r >= 0.0 && r <= 1.0;
+}
+
+bool Rectangle::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+    double t, s, r;
+    if (!crossing(ray, t, s, r)) return false;
+    record = HitRecord{.t = t,
+                       .shape = this,
+                       .primitive = 0,
+                       .u = static_cast<float>(s),
+                       .v = static_cast<float>(r)};
+    return true;
+}
+
+bool Rectangle::any_hit(const Ray& ray, QueryScratch&) const {
+    double t, s, r;
+    return crossing(ray, t, s, r);
+}
+
+Hit Rectangle::finish(const Ray& ray, const HitRecord& record) const {
+    Hit hit;
+    hit.t = record.t;
+    Vector3 offset = (ray.origin - corner_) + record.t * ray.direction;
+    // Back onto the plane: removes the rounding of o + t d along the normal.
+    offset -= offset.dot(normal_) * normal_;
+    hit.point = corner_ + offset;
+    hit.geometric_normal = normal_;
+    hit.shading_normal = normal_;
+    hit.uv =
+        Vector2(std::clamp(double(record.u), 0.0, 1.0), std::clamp(double(record.v), 0.0, 1.0));
+    hit.shape = this;
+    hit.primitive_id = record.primitive;
+    hit.front_face = ray.direction.dot(normal_) < 0.0;
+    return hit;
+}
+
+}  // namespace csgrt

@@ -1,0 +1,105 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/factory.h"
+#include "csgrt/accel/shape_set.h"
+#include "csgrt/core/shape.h"
+
+namespace csgrt {
+
+/// The structure "auto" picks for `count` bounded members (a compound's children, a scene's
+/// objects): "brute" for at most kHandfulOfMembers (testing a handful directly costs less than
+/// traversing a hierarchy over them), otherwise "bvh" when the factory knows it, else "brute".
+/// `reason` receives one sentence saying which rule applied.
+std::string choose_accelerator(std::size_t count, std::string& reason);
+
+/// At most this many bounded members are tested directly under "auto".
+inline constexpr std::size_t kHandfulOfMembers = 4;
+
+/// How a Compound organises its children.
+struct CompoundConfig {
+    /// "auto" (choose_accelerator) or a name make_accelerator knows.
+    std::string accelerator = "auto";
+    AcceleratorConfig accelerator_config;
+};
+
+/// A plain group of shapes (Suffern, "Ray Tracing from the Ground Up", 2007, ch. 19): the
+/// nearest hit among the children, no boolean. The bounded children sit in an acceleration
+/// structure built through make_accelerator (accel/factory.h); unbounded ones (planes) are kept
+/// apart and asked on every ray. A compound is itself a shape with a box, so compounds of
+/// compounds form a hierarchy of bounding boxes: a ray that misses a compound's box costs one
+/// box test, whatever is inside.
+///
+/// Hits carry `object` = the index of the child they belong to (an enclosing set overwrites it
+/// with its own member index); at equal t the lower child index wins.
+///
+/// A compound whose children are all solids is a solid: its spans are the union of the
+/// children's spans and `contains` is true inside any child. Its `nearest_hit` is still the
+/// nearest surface of any child, so the two agree only when the children do not overlap or
+/// touch (a ray starting inside one child would otherwise stop at another child's surface
+/// inside the material). For overlapping solids use make_union (csg/boolean.h), which removes
+/// internal surfaces.
+class Compound final : public Shape {
+public:
+    /// Throws InvalidParameter for a null child or an unknown structure name.
+    explicit Compound(std::vector<std::shared_ptr<const Shape>> children,
+                      const CompoundConfig& config = {});
+    Compound(const Compound&) = delete;
+    Compound& operator=(const Compound&) = delete;
+
+    std::string_view kind() const override { return "compound"; }
+    /// The join of the children's boxes (infinite when a child is unbounded).
+    Aabb bounds() const override { return bounds_; }
+    /// True when there is at least one child and every child is a solid.
+    bool is_solid() const override { return solid_; }
+
+    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
+    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
+    /// The union of the children's spans (combine_spans, so touching spans merge).
+    void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
+    /// Whether any child contains p.
+    bool contains(const Point3& p) const override;
+
+    std::size_t size() const { return children_.size(); }
+    const Shape& child(std::size_t i) const { return *children_[i]; }
+    const std::vector<std::shared_ptr<const Shape>>& children() const { return children_; }
+    /// The structure over the bounded children ("" when there are none), why it was chosen,
+    /// and its figures.
+    std::string_view accelerator_name() const;
+    const std::string& accelerator_reason() const { return accelerator_reason_; }
+    AcceleratorStats accelerator_stats() const;
+
+private:
+    /// The children's spans, unioned into `spans`: the candidates are children whose line has a
+    /// crossing at some t <= t_max (found through the structure) and unbounded solids.
+    void union_of_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const;
+
+    std::vector<std::shared_ptr<const Shape>> children_;
+    /// The bounded children, in child order, and the child index of each set member.
+    ShapeSet set_;
+    std::vector<std::uint32_t> set_child_;
+    std::unique_ptr<Accelerator<ShapeSet>> structure_;
+    /// Children with an infinite box, by child index.
+    std::vector<std::uint32_t> unbounded_;
+    Aabb bounds_;
+    bool solid_ = false;
+    std::string accelerator_reason_;
+};
+
+/// Groups `shapes` into a tree of nested compounds of at most `max_children` children each,
+/// splitting at the median of the box centres along the longest axis: hierarchical bounding
+/// boxes built by hand, as Suffern's compound objects do, independent of the structures in
+/// accel/. Unbounded shapes stay at the top. One shape is returned as it is. Throws
+/// InvalidParameter for an empty list, a null shape or max_children < 2.
+std::shared_ptr<const Shape> make_hierarchy(std::vector<std::shared_ptr<const Shape>> shapes,
+                                            std::size_t max_children = 4,
+                                            const CompoundConfig& config = {});
+
+}  // namespace csgrt

@@ -1,0 +1,112 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/factory.h"
+#include "csgrt/core/shape.h"
+#include "csgrt/csg/camera.h"
+
+namespace csgrt {
+
+/// A Lambertian surface colour (linear RGB albedo in [0, 1]).
+struct Material {
+    std::string name;
+    Vector3 albedo{0.8, 0.8, 0.8};
+};
+
+/// Light from a point, falling off with the squared distance.
+struct PointLight {
+    Point3 position{0.0, 10.0, 0.0};
+    /// Linear RGB intensity (radiance times squared distance).
+    Vector3 intensity{100.0, 100.0, 100.0};
+};
+
+/// Light from infinitely far away, arriving along `direction` (the way the light travels).
+struct DirectionalLight {
+    Vector3 direction{0.0, -1.0, 0.0};
+    Vector3 radiance{1.0, 1.0, 1.0};
+};
+
+using Light = std::variant<PointLight, DirectionalLight>;
+
+/// One top-level object of a scene.
+struct SceneObject {
+    std::shared_ptr<const Shape> shape;
+    std::uint32_t material = 0;
+    std::string name;
+};
+
+/// How `commit` organises the top-level objects.
+struct SceneConfig {
+    /// "auto" (the documented rule in docs/scene.md), or a structure name known to
+    /// make_accelerator ("brute", "bvh", "grid", "hgrid", "rayclass").
+    std::string accelerator = "auto";
+    AcceleratorConfig accelerator_config;
+};
+
+/// A scene: objects (any shape: primitives, instances, booleans, compounds, meshes), materials,
+/// lights and a camera. Follows the add -> commit -> query lifecycle: `commit` computes the
+/// bounds and builds the structure over the objects (unbounded objects such as planes are kept
+/// apart and tested on every ray); queries after that are const and thread-safe, each thread
+/// bringing its own QueryScratch. Adding after commit requires another commit.
+class Scene {
+public:
+    Scene();
+
+    /// Material 0 always exists: a neutral grey named "default". Returns the new material's
+    /// index. Throws InvalidParameter for an albedo outside [0, 1].
+    std::uint32_t add_material(Material material);
+    /// Returns the object's index (its object id in hits and in the renderer's id channel).
+    /// Throws InvalidParameter for a null shape or an unknown material.
+    std::uint32_t add_object(std::shared_ptr<const Shape> shape, std::uint32_t material = 0,
+                             std::string name = {});
+    void add_light(Light light);
+    void set_camera(Camera camera);
+
+    /// Builds everything queries need: validates the camera, computes the bounds, and builds
+    /// the structure over the bounded objects ("auto": choose_accelerator in csg/compound.h,
+    /// documented in docs/scene.md). Throws InvalidParameter for an invalid camera or an
+    /// unknown structure name; the scene is then left uncommitted.
+    void commit(const SceneConfig& config = {});
+    bool is_committed() const { return committed_; }
+
+    /// Nearest hit with t in [t_min, t_max], finished, with object_id set; nothing for an
+    /// invalid ray or an uncommitted scene.
+    std::optional<Hit> intersect(const Ray& ray, QueryScratch& scratch) const;
+    /// The same, counting the top-level structure's work into `counters`.
+    std::optional<Hit> intersect_counted(const Ray& ray, QueryScratch& scratch,
+                                         TraversalCounters& counters) const;
+    /// Whether anything is hit in [t_min, t_max] (shadow rays).
+    bool occluded(const Ray& ray, QueryScratch& scratch) const;
+
+    const std::vector<SceneObject>& objects() const { return objects_; }
+    const std::vector<Material>& materials() const { return materials_; }
+    const std::vector<Light>& lights() const { return lights_; }
+    const Camera& camera() const { return camera_; }
+    /// World bounds of the bounded objects (valid after commit).
+    const Aabb& bounds() const { return bounds_; }
+
+    /// The structure commit chose over the top-level objects, and why (for `csgrt info`).
+    std::string_view accelerator_name() const;
+    const std::string& accelerator_reason() const { return accelerator_reason_; }
+    AcceleratorStats accelerator_stats() const;
+
+private:
+    struct Committed;
+    std::vector<SceneObject> objects_;
+    std::vector<Material> materials_;
+    std::vector<Light> lights_;
+    Camera camera_;
+    Aabb bounds_;
+    bool committed_ = false;
+    std::string accelerator_reason_;
+    std::shared_ptr<const Committed> committed_state_;
+};
+
+}  // namespace csgrt

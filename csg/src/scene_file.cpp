@@ -1,0 +1,1033 @@
+#include "csgrt/csg/scene_file.h"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "csgrt/accel/mesh.h"
+#include "csgrt/core/error.h"
+#include "csgrt/core/shapes.h"
+#include "csgrt/csg/boolean.h"
+#include "csgrt/csg/compound.h"
+#include "csgrt/csg/ready_made.h"
+
+namespace csgrt {
+
+namespace {
+
+// ordered_json keeps the file's order, so materials get indices in the order they are written.
+using Json = nlohmann::ordered_json;
+using ShapePointer = std::shared_ptr<const Shape>;
+
+/// At most this many copies from one grid: a typo in a count must not exhaust memory.
+constexpr std::size_t kMaxGridCopies = 1'000'000;
+
+std::string escape_pointer_token(std::string_view token) {
+    std::string escaped;
+    for (const char c : token) {
+        if (c == '~') {
+            escaped += "~0";
+        } else if (c == '/') {
+            escaped += "~1";
+        } else {
+            escaped += c;
+        }
+    }
+    return escaped;
+}
+
+std::string child_pointer(const std::string& pointer, std::string_view key) {
+    return pointer + "/" + escape_pointer_token(key);
+}
+
+std::string child_pointer(const std::string& pointer, std::size_t index) {
+    return pointer + "/" + std::to_string(index);
+}
+
+/// A JSON value in a few words, for "expected ..., got ..." messages.
+std::string describe(const Json& value) {
+    switch (value.type()) {
+        case Json::value_t::null:
+            return "null";
+        case Json::value_t::boolean:
+            return value.get<bool>() ? "true" : "false";
+        case Json::value_t::string:
+            return "the string " + value.dump();
+        case Json::value_t::array:
+            return "an array of " + std::to_string(value.size());
+        case Json::value_t::object:
+            return "an object";
+        default:
+            return "the number " + value.dump();
+    }
+}
+
+/// Where in which file: everything a message needs besides what went wrong.
+struct Source {
+    std::string name;
+    std::filesystem::path directory;
+
+    [[noreturn]] void fail(const std::string& pointer, const std::string& message) const {
+        throw SceneError(name + ": " + (pointer.empty() ? std::string("(top level)") : pointer) +
+                         ": " + message);
+    }
+};
+
+/// One JSON object of the file, read key by key. Every key asked for is remembered, so
+/// `finish` can reject the keys nobody asked for and list the ones that are known.
+class Fields {
+public:
+    Fields(const Json& value, std::string pointer, const Source& source, std::string_view what)
+        : value_(value), pointer_(std::move(pointer)), source_(source), what_(what) {
+        if (!value_.is_object()) {
+            source_.fail(pointer_, "expected an object (" + what_ + "), got " + describe(value_));
+        }
+    }
+
+    const Json& value() const { return value_; }
+    const std::string& pointer() const { return pointer_; }
+    std::string pointer(std::string_view key) const { return child_pointer(pointer_, key); }
+    const Source& source() const { return source_; }
+    const std::string& what() const { return what_; }
+    void set_what(std::string what) { what_ = std::move(what); }
+
+    bool has(std::string_view key) {
+        ask(key);
+        return value_.contains(key);
+    }
+
+    /// The raw value of a required key.
+    const Json& required(std::string_view key, std::string_view expected) {
+        ask(key);
+        const auto found = value_.find(key);
+        if (found == value_.end()) {
+            source_.fail(pointer_, "missing required key \"" + std::string(key) + "\" (" +
+                                       std::string(expected) + ") in " + what_);
+        }
+        return *found;
+    }
+
+    double number(std::string_view key) {
+        return to_number(required(key, "a number"), pointer(key));
+    }
+    double number(std::string_view key, double fallback) {
+        return has(key) ? number(key) : fallback;
+    }
+    /// An angle written in degrees, returned in radians.
+    double degrees(std::string_view key, double fallback_degrees) {
+        return number(key, fallback_degrees) * kPi / 180.0;
+    }
+
+    std::size_t count(std::string_view key) {
+        const Json& value = required(key, "a whole number");
+        return to_count(value, pointer(key));
+    }
+
+    bool boolean(std::string_view key, bool fallback) {
+        if (!has(key)) return fallback;
+        const Json& value = value_.at(key);
+        if (!value.is_boolean()) fail(key, "expected true or false, got " + describe(value));
+        return value.get<bool>();
+    }
+
+    std::string string(std::string_view key) {
+        const Json& value = required(key, "a string");
+        if (!value.is_string()) fail(key, "expected a string, got " + describe(value));
+        return value.get<std::string>();
+    }
+    std::string string(std::string_view key, const std::string& fallback) {
+        return has(key) ? string(key) : fallback;
+    }
+
+    Vector3 vector(std::string_view key) {
+        return to_vector(required(key, "an array of 3 numbers"), pointer(key));
+    }
+    Vector3 vector(std::string_view key, const Vector3& fallback) {
+        return has(key) ? vector(key) : fallback;
+    }
+    /// A colour: an array of 3 numbers, or one number for a grey.
+    Vector3 colour(std::string_view key, const Vector3& fallback) {
+        if (!has(key)) return fallback;
+        const Json& value = value_.at(key);
+        if (value.is_number()) return Vector3::Constant(to_number(value, pointer(key)));
+        return to_vector(value, pointer(key));
+    }
+
+    /// A required array (of anything); `minimum` elements at least.
+    const Json& array(std::string_view key, std::size_t minimum, std::string_view of) {
+        const Json& value = required(key, "an array of " + std::string(of));
+        if (!value.is_array()) {
+            fail(key, "expected an array of " + std::string(of) + ", got " + describe(value));
+        }
+        if (value.size() < minimum) {
+            fail(key, "expected at least " + std::to_string(minimum) + " " + std::string(of) +
+                          ", got " + std::to_string(value.size()));
+        }
+        return value;
+    }
+
+    /// Rejects every key that was not asked for, naming the known ones.
+    void finish() const {
+        for (auto it = value_.begin(); it != value_.end(); ++it) {
+            if (std::find(asked_.begin(), asked_.end(), it.key()) != asked_.end()) continue;
+            std::string message = "unknown key \"" + it.key() + "\" in " + what_;
+            if (it.key() == "material" || it.key() == "name") {
+                message += " (\"" + it.key() + "\" belongs to the top-level objects)";
+            } else if (it.key() == "materials") {
+                message += " (\"materials\" belongs to top-level grids)";
+            }
+            std::string known;
+            for (const std::string& key : asked_) known += (known.empty() ? "" : ", ") + key;
+            source_.fail(pointer(it.key()), message + "; expected one of: " + known);
+        }
+    }
+
+    [[noreturn]] void fail(std::string_view key, const std::string& message) const {
+        source_.fail(key.empty() ? pointer_ : pointer(key), message);
+    }
+
+    double to_number(const Json& value, const std::string& at) const {
+        if (!value.is_number()) source_.fail(at, "expected a number, got " + describe(value));
+        const double number = value.get<double>();
+        // JSON has no NaN or infinity, but a literal like 1e999 overflows to infinity.
+        if (!std::isfinite(number))
+            source_.fail(at, "expected a finite number, got " + value.dump());
+        return number;
+    }
+
+    std::size_t to_count(const Json& value, const std::string& at) const {
+        if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
+            source_.fail(at, "expected a whole number >= 0, got " + describe(value));
+        }
+        return value.get<std::size_t>();
+    }
+
+    Vector3 to_vector(const Json& value, const std::string& at) const {
+        if (!value.is_array() || value.size() != 3) {
+            source_.fail(at, "expected an array of 3 numbers, got " + describe(value));
+        }
+        return Vector3(to_number(value[0], child_pointer(at, 0)),
+                       to_number(value[1], child_pointer(at, 1)),
+                       to_number(value[2], child_pointer(at, 2)));
+    }
+
+private:
+    void ask(std::string_view key) {
+        if (std::find(asked_.begin(), asked_.end(), key) == asked_.end()) asked_.emplace_back(key);
+    }
+
+    const Json& value_;
+    std::string pointer_;
+    const Source& source_;
+    std::string what_;
+    std::vector<std::string> asked_;
+};
+
+class Loader;
+
+/// One entry of the shape table: the "type" keyword and how to build it from its fields.
+/// Adding a shape to the format is one entry here.
+struct ShapeEntry {
+    std::string_view type;
+    ShapePointer (*build)(Fields& fields, Loader& loader);
+    /// Whether the entry reads angles (in degrees; the shapes take radians).
+    bool angles = false;
+};
+
+/// A place in a list (objects, children, operands) after grids are expanded: the shape and
+/// the pointer of the node it came from.
+struct ListItem {
+    ShapePointer shape;
+    std::string pointer;
+};
+
+class Loader {
+public:
+    Loader(const Json& root, const Source& source) : root_(root), source_(source) {}
+
+    Scene load();
+
+    /// Builds the shape described by the node at `pointer`; `fields` may already have had
+    /// top-level keys read from it.
+    ShapePointer shape(Fields& fields);
+    ShapePointer shape(const Json& value, const std::string& pointer, std::string_view what) {
+        Fields fields(value, pointer, source_, what);
+        ShapePointer built = shape(fields);
+        fields.finish();
+        return built;
+    }
+
+    /// The shapes of an array of nodes, with every grid replaced by its copies.
+    std::vector<ListItem> list(Fields& fields, std::string_view key, std::size_t minimum,
+                               std::string_view of);
+
+    /// The copies of a grid node, each its item moved into place.
+    std::vector<ShapePointer> grid(Fields& fields);
+
+    ShapePointer definition(const std::string& name, const std::string& pointer);
+
+    /// A mesh node: the file at "path", relative to the scene file's folder, loaded once per
+    /// path and settings however often it is named.
+    ShapePointer mesh(Fields& fields);
+
+    const Source& source() const { return source_; }
+
+    Transform transform(const Json& list, const std::string& pointer) const;
+
+private:
+    void camera(Scene& scene);
+    void materials(Scene& scene, std::map<std::string, std::uint32_t>& by_name);
+    void lights(Scene& scene);
+
+    const Json& root_;
+    const Source& source_;
+    const Json* definitions_ = nullptr;
+    std::map<std::string, ShapePointer> built_;
+    std::map<std::string, ShapePointer> meshes_;
+    /// Definitions being built, outermost first: a name met again here is a cycle.
+    std::vector<std::string> building_;
+};
+
+/// `shape` placed by `world_from_object`; nested instances are folded into one.
+ShapePointer place(ShapePointer shape, const Transform& world_from_object) {
+    if (world_from_object.is_identity()) return shape;
+    if (const auto* instance = dynamic_cast<const Instance*>(shape.get())) {
+        return std::make_shared<Instance>(instance->shared_shape(),
+                                          world_from_object * instance->world_from_object());
+    }
+    return std::make_shared<Instance>(std::move(shape), world_from_object);
+}
+
+std::string solid_requirement(const ListItem& item) {
+    std::string kind(item.shape->kind());
+    if (kind == "mesh") kind = "an open mesh (one with a boundary, not a closed surface)";
+    return "expected a solid (a closed shape: sphere, box, capped cylinder or cone, torus, "
+           "boolean, ready-made solid, compound of solids, closed mesh) as a boolean operand, "
+           "got " +
+           kind;
+}
+
+std::vector<ShapePointer> operand_shapes(const std::vector<ListItem>& items, const Source& source) {
+    std::vector<ShapePointer> shapes;
+    for (const ListItem& item : items) {
+        if (!item.shape->is_solid()) source.fail(item.pointer, solid_requirement(item));
+        shapes.push_back(item.shape);
+    }
+    return shapes;
+}
+
+std::vector<ShapePointer> plain_shapes(const std::vector<ListItem>& items) {
+    std::vector<ShapePointer> shapes;
+    for (const ListItem& item : items) shapes.push_back(item.shape);
+    return shapes;
+}
+
+CompoundConfig compound_config(Fields& fields) {
+    CompoundConfig config;
+    config.accelerator = fields.string("accelerator", "auto");
+    return config;
+}
+
+const ShapeEntry kShapeTable[] = {
+    {"sphere",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 center = f.vector("center", Point3::Zero());
+         return std::make_shared<Sphere>(center, f.number("radius"));
+     }},
+    {"plane",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 point = f.vector("point", Point3::Zero());
+         return std::make_shared<Plane>(point, f.vector("normal"));
+     }},
+    {"triangle",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 p0 = f.vector("p0");
+         const Point3 p1 = f.vector("p1");
+         return std::make_shared<Triangle>(p0, p1, f.vector("p2"));
+     }},
+    {"disk",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 center = f.vector("center", Point3::Zero());
+         const Normal3 normal = f.vector("normal");
+         return std::make_shared<Disk>(center, normal, f.number("radius"));
+     }},
+    {"rectangle",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 corner = f.vector("corner");
+         const Vector3 edge_a = f.vector("edge_a");
+         return std::make_shared<Rectangle>(corner, edge_a, f.vector("edge_b"));
+     }},
+    {"box",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 lower = f.vector("lower");
+         return std::make_shared<Box>(lower, f.vector("upper"));
+     }},
+    {"cylinder",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const double radius = f.number("radius");
+         const double y_min = f.number("y_min");
+         const double y_max = f.number("y_max");
+         return std::make_shared<Cylinder>(radius, y_min, y_max, f.boolean("capped", true));
+     }},
+    {"cone",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const double base_radius = f.number("base_radius");
+         const double top_radius = f.number("top_radius", 0.0);
+         const double height = f.number("height");
+         return std::make_shared<Cone>(base_radius, top_radius, height, f.boolean("capped", true));
+     }},
+    {"part_sphere",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 center = f.vector("center", Point3::Zero());
+         const double radius = f.number("radius");
+         const double phi_min = f.degrees("phi_min", 0.0);
+         const double phi_max = f.degrees("phi_max", 360.0);
+         const double theta_min = f.degrees("theta_min", 0.0);
+         return std::make_shared<PartSphere>(center, radius, phi_min, phi_max, theta_min,
+                                             f.degrees("theta_max", 180.0));
+     },
+     true},
+    {"part_cylinder",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const double radius = f.number("radius");
+         const double y_min = f.number("y_min");
+         const double y_max = f.number("y_max");
+         const double phi_min = f.degrees("phi_min", 0.0);
+         return std::make_shared<PartCylinder>(radius, y_min, y_max, phi_min,
+                                               f.degrees("phi_max", 360.0));
+     },
+     true},
+    {"annulus",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 center = f.vector("center", Point3::Zero());
+         const Normal3 normal = f.vector("normal");
+         const double inner_radius = f.number("inner_radius", 0.0);
+         const double outer_radius = f.number("outer_radius");
+         const double phi_min = f.degrees("phi_min", 0.0);
+         return std::make_shared<Annulus>(center, normal, inner_radius, outer_radius, phi_min,
+                                          f.degrees("phi_max", 360.0));
+     },
+     true},
+    {"torus",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const double major_radius = f.number("major_radius");
+         return std::make_shared<Torus>(major_radius, f.number("minor_radius"));
+     }},
+    {"part_torus",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const double major_radius = f.number("major_radius");
+         const double minor_radius = f.number("minor_radius");
+         const double phi_min = f.degrees("phi_min", 0.0);
+         const double phi_max = f.degrees("phi_max", 360.0);
+         const double theta_min = f.degrees("theta_min", 0.0);
+         return std::make_shared<PartTorus>(major_radius, minor_radius, phi_min, phi_max, theta_min,
+                                            f.degrees("theta_max", 360.0));
+     },
+     true},
+    {"mesh", [](Fields& f, Loader& loader) -> ShapePointer { return loader.mesh(f); }},
+    {"solid_cylinder",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 bottom = f.vector("bottom");
+         const Point3 top = f.vector("top");
+         return make_solid_cylinder(bottom, top, f.number("radius"));
+     }},
+    {"solid_cone",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 base = f.vector("base");
+         const Point3 top = f.vector("top");
+         const double base_radius = f.number("base_radius");
+         return make_solid_cone(base, top, base_radius, f.number("top_radius", 0.0));
+     }},
+    {"thick_ring",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const double y_min = f.number("y_min");
+         const double y_max = f.number("y_max");
+         const double inner_radius = f.number("inner_radius");
+         return make_thick_ring(y_min, y_max, inner_radius, f.number("outer_radius"));
+     }},
+    {"bowl",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const double outer_radius = f.number("outer_radius");
+         return make_bowl(outer_radius, f.number("inner_radius"));
+     }},
+    {"rounded_box",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 lower = f.vector("lower");
+         const Point3 upper = f.vector("upper");
+         return make_rounded_box(lower, upper, f.number("radius"));
+     }},
+    {"union",
+     [](Fields& f, Loader& loader) -> ShapePointer {
+         return make_union(
+             operand_shapes(loader.list(f, "operands", 2, "operand shapes"), loader.source()));
+     }},
+    {"intersection",
+     [](Fields& f, Loader& loader) -> ShapePointer {
+         return make_intersection(
+             operand_shapes(loader.list(f, "operands", 2, "operand shapes"), loader.source()));
+     }},
+    {"difference",
+     [](Fields& f, Loader& loader) -> ShapePointer {
+         std::vector<ShapePointer> operands = operand_shapes(
+             loader.list(f, "operands", 2, "operand shapes (the first minus the others)"),
+             loader.source());
+         const ShapePointer first = operands.front();
+         operands.erase(operands.begin());
+         return make_difference(first, operands);
+     }},
+    {"compound",
+     [](Fields& f, Loader& loader) -> ShapePointer {
+         auto children = plain_shapes(loader.list(f, "children", 1, "child shapes"));
+         return std::make_shared<Compound>(std::move(children), compound_config(f));
+     }},
+    {"grid",
+     [](Fields& f, Loader& loader) -> ShapePointer {
+         // Outside a list a grid is one shape: the compound of its copies.
+         auto copies = loader.grid(f);
+         return std::make_shared<Compound>(std::move(copies), compound_config(f));
+     }},
+    {"ref",
+     [](Fields& f, Loader& loader) -> ShapePointer {
+         return loader.definition(f.string("definition"), f.pointer("definition"));
+     }},
+};
+
+const ShapeEntry* find_entry(std::string_view type) {
+    for (const ShapeEntry& entry : kShapeTable) {
+        if (entry.type == type) return &entry;
+    }
+    return nullptr;
+}
+
+std::string known_types() {
+    std::string known;
+    for (const ShapeEntry& entry : kShapeTable) {
+        known += (known.empty() ? "" : ", ") + std::string(entry.type);
+    }
+    return known;
+}
+
+/// Turns a shape's InvalidParameter ("Sphere: radius must be > 0 ...") into a SceneError at the
+/// key the message names, when the node has that key, else at the node.
+[[noreturn]] void rethrow_invalid(const InvalidParameter& error, const Fields& fields,
+                                  const Json& node, bool angles) {
+    std::string message = error.what();
+    std::string pointer = fields.pointer();
+    const auto colon = message.find(": ");
+    const auto must = message.find(" must be ");
+    if (colon != std::string::npos && must != std::string::npos && must > colon) {
+        std::string parameter = message.substr(colon + 2, must - colon - 2);
+        // The structure name of a compound or grid is its "accelerator" key; the keys every
+        // node may have are never a shape's parameter.
+        if (message.starts_with("make_accelerator: name")) parameter = "accelerator";
+        const bool shape_key = parameter != "name" && parameter != "material" &&
+                               parameter != "type" && parameter != "transform";
+        if (shape_key && node.is_object() && node.contains(parameter)) {
+            pointer = fields.pointer(parameter);
+        }
+        if (angles && (parameter.starts_with("phi") || parameter.starts_with("theta"))) {
+            message += " (radians: the file's degrees times pi / 180)";
+        }
+    }
+    fields.source().fail(pointer, message);
+}
+
+ShapePointer Loader::shape(Fields& fields) {
+    const std::string type = fields.string("type");
+    const ShapeEntry* entry = find_entry(type);
+    if (entry == nullptr) {
+        fields.fail("type",
+                    "unknown shape type \"" + type + "\"; expected one of: " + known_types());
+    }
+    fields.set_what("a " + type);
+    ShapePointer built;
+    try {
+        built = entry->build(fields, *this);
+    } catch (const InvalidParameter& error) {
+        rethrow_invalid(error, fields, fields.value(), entry->angles);
+    }
+    if (fields.has("transform")) {
+        built = place(std::move(built), transform(fields.array("transform", 0, "transforms"),
+                                                  fields.pointer("transform")));
+    }
+    return built;
+}
+
+std::vector<ListItem> Loader::list(Fields& fields, std::string_view key, std::size_t minimum,
+                                   std::string_view of) {
+    const Json& array = fields.array(key, 1, of);
+    const std::string pointer = fields.pointer(key);
+    std::vector<ListItem> items;
+    for (std::size_t i = 0; i < array.size(); ++i) {
+        const std::string at = child_pointer(pointer, i);
+        Fields element(array[i], at, source_, "an element of \"" + std::string(key) + "\"");
+        if (element.has("type") && array[i].at("type") == "grid") {
+            element.string("type");
+            element.set_what("a grid");
+            for (ShapePointer& copy : grid(element)) items.push_back({std::move(copy), at});
+        } else {
+            items.push_back({shape(element), at});
+        }
+        element.finish();
+    }
+    if (items.size() < minimum) {
+        fields.fail(key, "expected at least " + std::to_string(minimum) + " " + std::string(of) +
+                             " (after expanding grids), got " + std::to_string(items.size()));
+    }
+    return items;
+}
+
+std::vector<ShapePointer> Loader::grid(Fields& fields) {
+    const Json& count = fields.required("count", "an array of 3 whole numbers >= 1");
+    if (!count.is_array() || count.size() != 3) {
+        fields.fail("count", "expected an array of 3 whole numbers >= 1, got " + describe(count));
+    }
+    std::size_t counts[3];
+    std::size_t total = 1;
+    for (int axis = 0; axis < 3; ++axis) {
+        counts[axis] = fields.to_count(count[axis], child_pointer(fields.pointer("count"), axis));
+        if (counts[axis] == 0) {
+            fields.fail("count",
+                        "expected every count >= 1, got 0 at index " + std::to_string(axis));
+        }
+        // Both factors stay <= kMaxGridCopies + 1, so the product cannot overflow.
+        total = counts[axis] > kMaxGridCopies ? kMaxGridCopies + 1
+                                              : std::min(total * counts[axis], kMaxGridCopies + 1);
+    }
+    if (total > kMaxGridCopies) {
+        fields.fail("count",
+                    "expected at most " + std::to_string(kMaxGridCopies) + " copies in one grid");
+    }
+    const Vector3 spacing = fields.vector("spacing");
+    const ShapePointer item =
+        shape(fields.required("item", "a shape node"), fields.pointer("item"), "a grid item");
+    Transform placement;
+    if (fields.has("transform")) {
+        placement =
+            transform(fields.array("transform", 0, "transforms"), fields.pointer("transform"));
+    }
+    // Copies in x-fastest order, centred on the origin, then the grid's own transform.
+    std::vector<ShapePointer> copies;
+    copies.reserve(total);
+    for (std::size_t k = 0; k < counts[2]; ++k) {
+        for (std::size_t j = 0; j < counts[1]; ++j) {
+            for (std::size_t i = 0; i < counts[0]; ++i) {
+                const Vector3 offset(
+                    (static_cast<double>(i) - 0.5 * static_cast<double>(counts[0] - 1)) *
+                        spacing.x(),
+                    (static_cast<double>(j) - 0.5 * static_cast<double>(counts[1] - 1)) *
+                        spacing.y(),
+                    (static_cast<double>(k) - 0.5 * static_cast<double>(counts[2] - 1)) *
+                        spacing.z());
+                copies.push_back(place(item, placement * Transform::translate(offset)));
+            }
+        }
+    }
+    return copies;
+}
+
+ShapePointer Loader::definition(const std::string& name, const std::string& pointer) {
+    if (const auto found = built_.find(name); found != built_.end()) return found->second;
+    if (definitions_ == nullptr || !definitions_->contains(name)) {
+        std::string known;
+        if (definitions_ != nullptr) {
+            for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
+                known += (known.empty() ? "" : ", ") + it.key();
+            }
+        }
+        source_.fail(pointer, "no definition named \"" + name + "\"" +
+                                  (known.empty() ? " (the file has no \"definitions\")"
+                                                 : "; defined: " + known));
+    }
+    if (std::find(building_.begin(), building_.end(), name) != building_.end()) {
+        std::string cycle;
+        for (auto it = std::find(building_.begin(), building_.end(), name); it != building_.end();
+             ++it) {
+            cycle += *it + " -> ";
+        }
+        source_.fail(pointer, "reference cycle: " + cycle + name);
+    }
+    building_.push_back(name);
+    ShapePointer built = shape(definitions_->at(name), child_pointer("/definitions", name),
+                               "the definition \"" + name + "\"");
+    building_.pop_back();
+    built_[name] = built;
+    return built;
+}
+
+ShapePointer Loader::mesh(Fields& fields) {
+    const std::string path = fields.string("path");
+    MeshConfig config;
+    config.double_precision = fields.boolean("double_precision", false);
+    config.accelerator = fields.string("accelerator", config.accelerator);
+    const std::filesystem::path file = source_.directory / path;
+    const std::string key = file.lexically_normal().string() + "|" +
+                            (config.double_precision ? "double" : "float") + "|" +
+                            config.accelerator;
+    if (const auto found = meshes_.find(key); found != meshes_.end()) return found->second;
+    ShapePointer loaded;
+    try {
+        loaded = Mesh::load(file, config);
+    } catch (const MeshError& error) {
+        fields.fail("path", std::string("cannot use the mesh: ") + error.what());
+    } catch (const InvalidParameter& error) {
+        // An unknown structure name.
+        fields.fail("accelerator", error.what());
+    }
+    meshes_[key] = loaded;
+    return loaded;
+}
+
+Transform Loader::transform(const Json& list, const std::string& pointer) const {
+    // Each entry acts on the result of the ones before it: world = T_n ... T_2 T_1.
+    Transform world_from_object;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string at = child_pointer(pointer, i);
+        const Json& entry = list[i];
+        if (!entry.is_object() || entry.size() != 1) {
+            source_.fail(at,
+                         "expected an object with one key (translate, rotate, scale, shear "
+                         "or matrix), got " +
+                             describe(entry));
+        }
+        const std::string kind = entry.begin().key();
+        const Json& value = entry.begin().value();
+        const std::string value_at = child_pointer(at, kind);
+        Fields probe(entry, at, source_, "a transform");
+        Transform step;
+        try {
+            if (kind == "translate") {
+                step = Transform::translate(probe.to_vector(value, value_at));
+            } else if (kind == "scale") {
+                step = value.is_number() ? Transform::scale(probe.to_number(value, value_at))
+                                         : Transform::scale(probe.to_vector(value, value_at));
+            } else if (kind == "rotate") {
+                Fields rotate(value, value_at, source_, "a rotation");
+                const Vector3 axis = rotate.vector("axis");
+                step = Transform::rotate(axis, rotate.number("degrees") * kPi / 180.0);
+                rotate.finish();
+            } else if (kind == "shear") {
+                Fields shear(value, value_at, source_, "a shear");
+                auto axis_of = [&](std::string_view key) {
+                    const std::string name = shear.string(key);
+                    if (name == "x") return 0;
+                    if (name == "y") return 1;
+                    if (name == "z") return 2;
+                    shear.fail(key, "expected \"x\", \"y\" or \"z\", got \"" + name + "\"");
+                };
+                const int axis = axis_of("axis");
+                const int by = axis_of("by");
+                if (by == axis) shear.fail("by", "expected an axis other than \"axis\"");
+                step = Transform::shear(axis, by, shear.number("factor"));
+                shear.finish();
+            } else if (kind == "matrix") {
+                if (!value.is_array() || value.size() != 4) {
+                    source_.fail(value_at, "expected 4 rows of 4 numbers, got " + describe(value));
+                }
+                Eigen::Matrix4d matrix;
+                for (int row = 0; row < 4; ++row) {
+                    const Json& values = value[row];
+                    const std::string row_at = child_pointer(value_at, row);
+                    if (!values.is_array() || values.size() != 4) {
+                        source_.fail(row_at,
+                                     "expected a row of 4 numbers, got " + describe(values));
+                    }
+                    for (int column = 0; column < 4; ++column) {
+                        matrix(row, column) =
+                            probe.to_number(values[column], child_pointer(row_at, column));
+                    }
+                }
+                step = Transform::from_matrix(matrix);
+            } else {
+                source_.fail(child_pointer(at, kind),
+                             "unknown transform \"" + kind +
+                                 "\"; expected one of: translate, rotate, scale, shear, matrix");
+            }
+        } catch (const InvalidParameter& error) {
+            source_.fail(value_at, error.what());
+        }
+        world_from_object = step * world_from_object;
+    }
+    return world_from_object;
+}
+
+void Loader::camera(Scene& scene) {
+    Camera camera;
+    if (root_.contains("camera")) {
+        Fields fields(root_.at("camera"), "/camera", source_, "the camera");
+        const std::string projection = fields.string("projection", "pinhole");
+        if (projection == "orthographic") {
+            camera.projection = Camera::Projection::Orthographic;
+        } else if (projection != "pinhole") {
+            fields.fail("projection",
+                        "expected \"pinhole\" or \"orthographic\", got \"" + projection + "\"");
+        }
+        camera.position = fields.vector("position", camera.position);
+        camera.look_at = fields.vector("look_at", camera.look_at);
+        camera.up = fields.vector("up", camera.up);
+        camera.vertical_fov_degrees =
+            fields.number("vertical_fov_degrees", camera.vertical_fov_degrees);
+        camera.orthographic_height =
+            fields.number("orthographic_height", camera.orthographic_height);
+        fields.finish();
+        try {
+            camera.validate();
+        } catch (const InvalidParameter& error) {
+            rethrow_invalid(error, fields, root_.at("camera"), false);
+        }
+    }
+    scene.set_camera(camera);
+}
+
+void Loader::materials(Scene& scene, std::map<std::string, std::uint32_t>& by_name) {
+    by_name["default"] = 0;
+    if (!root_.contains("materials")) return;
+    const Json& materials = root_.at("materials");
+    if (!materials.is_object()) {
+        source_.fail("/materials",
+                     "expected an object of named materials, got " + describe(materials));
+    }
+    for (auto it = materials.begin(); it != materials.end(); ++it) {
+        const std::string at = child_pointer("/materials", it.key());
+        if (it.key() == "default") {
+            source_.fail(at, "the name \"default\" is taken by material 0, the neutral grey");
+        }
+        Fields fields(it.value(), at, source_, "a material");
+        Material material{it.key(), fields.colour("albedo", Vector3(0.8, 0.8, 0.8))};
+        fields.finish();
+        try {
+            by_name[it.key()] = scene.add_material(material);
+        } catch (const InvalidParameter& error) {
+            source_.fail(child_pointer(at, "albedo"), error.what());
+        }
+    }
+}
+
+void Loader::lights(Scene& scene) {
+    if (!root_.contains("lights")) return;
+    const Json& lights = root_.at("lights");
+    if (!lights.is_array()) {
+        source_.fail("/lights", "expected an array of lights, got " + describe(lights));
+    }
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        const std::string at = child_pointer("/lights", i);
+        Fields fields(lights[i], at, source_, "a light");
+        const std::string type = fields.string("type");
+        auto check_colour = [&](std::string_view key, const Vector3& colour) {
+            if (!(colour.array() >= 0.0).all()) {
+                fields.fail(key, "expected values >= 0, got " + detail::describe(colour));
+            }
+        };
+        if (type == "point") {
+            fields.set_what("a point light");
+            PointLight light;
+            light.position = fields.vector("position");
+            light.intensity = fields.colour("intensity", light.intensity);
+            check_colour("intensity", light.intensity);
+            scene.add_light(light);
+        } else if (type == "directional") {
+            fields.set_what("a directional light");
+            DirectionalLight light;
+            light.direction = fields.vector("direction");
+            if (light.direction.squaredNorm() == 0.0) {
+                fields.fail("direction", "expected a non-zero direction, got (0, 0, 0)");
+            }
+            light.radiance = fields.colour("radiance", light.radiance);
+            check_colour("radiance", light.radiance);
+            scene.add_light(light);
+        } else {
+            fields.fail("type", "expected \"point\" or \"directional\", got \"" + type + "\"");
+        }
+        fields.finish();
+    }
+}
+
+Scene Loader::load() {
+    Fields top(root_, "", source_, "the scene");
+    Scene scene;
+    // Asked for so finish() accepts them; each is read below.
+    for (const char* key : {"description", "camera", "materials", "lights", "definitions"})
+        top.has(key);
+    if (top.has("description")) top.string("description");
+    camera(scene);
+    std::map<std::string, std::uint32_t> material_index;
+    materials(scene, material_index);
+    lights(scene);
+    if (top.has("definitions")) {
+        definitions_ = &root_.at("definitions");
+        if (!definitions_->is_object()) {
+            source_.fail("/definitions",
+                         "expected an object of named shapes, got " + describe(*definitions_));
+        }
+        // Every definition is built, used or not, so its errors are reported.
+        for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
+            definition(it.key(), child_pointer("/definitions", it.key()));
+        }
+    }
+    const Json& objects = top.array("objects", 0, "objects");
+    top.finish();
+    auto material_of = [&](Fields& fields, const std::string& name) {
+        const auto found = material_index.find(name);
+        if (found == material_index.end()) {
+            std::string known;
+            for (const auto& [known_name, index] : material_index) {
+                known += (known.empty() ? "" : ", ") + known_name;
+            }
+            fields.fail("material", "no material named \"" + name + "\"; defined: " + known);
+        }
+        return found->second;
+    };
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        Fields fields(objects[i], child_pointer("/objects", i), source_, "a scene object");
+        const std::string name = fields.string("name", "");
+        const bool is_grid = fields.has("type") && objects[i].at("type") == "grid";
+        std::vector<std::uint32_t> palette;
+        if (is_grid && fields.has("materials")) {
+            const Json& names = fields.array("materials", 1, "material names");
+            for (std::size_t m = 0; m < names.size(); ++m) {
+                if (!names[m].is_string()) {
+                    source_.fail(child_pointer(fields.pointer("materials"), m),
+                                 "expected a material name, got " + describe(names[m]));
+                }
+                palette.push_back(material_of(fields, names[m].get<std::string>()));
+            }
+            if (fields.has("material")) {
+                fields.fail("material", "expected either \"material\" or \"materials\", not both");
+            }
+        } else {
+            palette.push_back(material_of(fields, fields.string("material", "default")));
+        }
+        if (is_grid) {
+            fields.string("type");
+            fields.set_what("a grid");
+            const auto copies = grid(fields);
+            fields.finish();
+            for (std::size_t c = 0; c < copies.size(); ++c) {
+                scene.add_object(copies[c], palette[c % palette.size()],
+                                 name.empty() ? name : name + "[" + std::to_string(c) + "]");
+            }
+        } else {
+            ShapePointer built = shape(fields);
+            fields.finish();
+            scene.add_object(std::move(built), palette.front(), name);
+        }
+    }
+    return scene;
+}
+
+/// Rejects duplicate keys while parsing (nlohmann keeps the last one silently), naming the
+/// object they are in by its JSON pointer.
+class DuplicateKeyCheck {
+public:
+    explicit DuplicateKeyCheck(const Source& source) : source_(source) {}
+
+    bool operator()(int, Json::parse_event_t event, Json& parsed) {
+        using Event = Json::parse_event_t;
+        switch (event) {
+            case Event::object_start:
+            case Event::array_start:
+                enter_element();
+                frames_.push_back(Frame{event == Event::array_start, 0, {}, {}});
+                break;
+            case Event::object_end:
+            case Event::array_end:
+                frames_.pop_back();
+                break;
+            case Event::key: {
+                Frame& frame = frames_.back();
+                const std::string key = parsed.get<std::string>();
+                if (!frame.keys.insert(key).second) {
+                    source_.fail(path() + "/" + escape_pointer_token(key),
+                                 "duplicate key \"" + key + "\" (JSON keeps only one of them)");
+                }
+                frame.key = key;
+                break;
+            }
+            case Event::value:
+                enter_element();
+                break;
+        }
+        return true;
+    }
+
+private:
+    struct Frame {
+        bool array;
+        std::size_t next_index;
+        std::string key;
+        std::set<std::string> keys;
+    };
+
+    void enter_element() {
+        if (!frames_.empty() && frames_.back().array) ++frames_.back().next_index;
+    }
+
+    /// The pointer of the innermost open object.
+    std::string path() const {
+        std::string pointer;
+        for (std::size_t i = 0; i + 1 < frames_.size(); ++i) {
+            pointer += "/" + (frames_[i].array ? std::to_string(frames_[i].next_index - 1)
+                                               : escape_pointer_token(frames_[i].key));
+        }
+        return pointer;
+    }
+
+    const Source& source_;
+    std::vector<Frame> frames_;
+};
+
+Scene load(std::string_view text, const Source& source) {
+    Json root;
+    try {
+        root = Json::parse(text, DuplicateKeyCheck(source));
+    } catch (const nlohmann::json::parse_error& error) {
+        // what() is "[json.exception.parse_error.101] parse error at line 3, column 5: ...".
+        std::string message = error.what();
+        const auto start = message.find("] ");
+        if (start != std::string::npos) message.erase(0, start + 2);
+        throw SceneError(source.name + ": invalid JSON: " + message);
+    } catch (const nlohmann::json::exception& error) {
+        // A number too large for a double ("[json.exception.out_of_range.406] ...").
+        std::string message = error.what();
+        const auto start = message.find("] ");
+        if (start != std::string::npos) message.erase(0, start + 2);
+        throw SceneError(source.name + ": invalid JSON: " + message);
+    }
+    try {
+        return Loader(root, source).load();
+    } catch (const nlohmann::json::exception& error) {
+        // Every value is checked before it is converted; this is a guard, not a path.
+        throw SceneError(source.name + ": " + error.what());
+    }
+}
+
+}  // namespace
+
+Scene load_scene(const std::filesystem::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) throw SceneError(path.string() + ": cannot open the scene file");
+    std::ostringstream text;
+    text << file.rdbuf();
+    if (!file.good() && !file.eof()) throw SceneError(path.string() + ": cannot read the file");
+    return load(text.str(), Source{path.string(), path.parent_path()});
+}
+
+Scene load_scene_from_string(std::string_view text, const std::string& name,
+                             const std::filesystem::path& directory) {
+    return load(text, Source{name, directory});
+}
+
+std::span<const std::string_view> scene_shape_types() {
+    static const std::vector<std::string_view> types = [] {
+        std::vector<std::string_view> list;
+        for (const ShapeEntry& entry : kShapeTable) list.push_back(entry.type);
+        return list;
+    }();
+    return types;
+}
+
+}  // namespace csgrt

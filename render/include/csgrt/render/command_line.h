@@ -1,0 +1,23 @@
+#pragma once
+
+#include <iosfwd>
+
+namespace csgrt {
+
+/// Where the csgrt program writes: results to `out`, errors and the progress bar to `err`.
+/// The progress bar is drawn only when `err_is_terminal` and a render has run for
+/// `progress_delay_seconds`, so short renders stay silent.
+struct CommandLineStreams {
+    std::ostream& out;
+    std::ostream& err;
+    bool err_is_terminal = false;
+    double progress_delay_seconds = 1.0;
+};
+
+/// The csgrt program (docs/rendering.md): `render SCENE.json -o OUT.exr [options]`,
+/// `info SCENE.json`, `validate SCENE.json`. Returns the exit status: 0 on success, 1 on any
+/// error, reported as one line "csgrt: error: ..." on `err`. Nothing is written to the output
+/// paths unless the render succeeds, and then each file appears whole.
+int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams);
+
+}  // namespace csgrt

@@ -1,0 +1,60 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "csgrt/core/math.h"
+
+namespace csgrt {
+
+/// Everything the renderer knows about one pixel. Colour is linear RGB, premultiplied by
+/// alpha (the background is transparent black). The other channels (AOVs) come from one ray
+/// through the pixel centre: depth is its t (the camera's rays have unit directions, so t is
+/// the distance from the camera origin; +inf where nothing is hit), normal is the world-space
+/// shading normal of the surface as the surface defines it (outward for solids, not turned
+/// toward the camera; zero for background), object_id the scene object (kNoIndex for
+/// background) and cost the work the scene's top-level structure did for that ray.
+struct Pixel {
+    float red = 0.0f;
+    float green = 0.0f;
+    float blue = 0.0f;
+    float alpha = 0.0f;
+    float depth = std::numeric_limits<float>::infinity();
+    float normal_x = 0.0f;
+    float normal_y = 0.0f;
+    float normal_z = 0.0f;
+    std::uint32_t object_id = kNoIndex;
+    /// Nodes or cells visited plus primitives tested (exact as float up to 2^24).
+    float cost = 0.0f;
+};
+
+/// A rendered image: width x height pixels, row-major from the top-left corner.
+class Image {
+public:
+    Image() = default;
+    /// Throws InvalidParameter unless width and height are positive.
+    Image(int width, int height);
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+    std::size_t pixel_count() const { return pixels_.size(); }
+
+    Pixel& at(int x, int y) { return pixels_[index(x, y)]; }
+    const Pixel& at(int x, int y) const { return pixels_[index(x, y)]; }
+    std::vector<Pixel>& pixels() { return pixels_; }
+    const std::vector<Pixel>& pixels() const { return pixels_; }
+
+private:
+    std::size_t index(int x, int y) const {
+        return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+               static_cast<std::size_t>(x);
+    }
+
+    int width_ = 0;
+    int height_ = 0;
+    std::vector<Pixel> pixels_;
+};
+
+}  // namespace csgrt

@@ -1,0 +1,71 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "csgrt/render/image.h"
+
+namespace csgrt {
+
+class Scene;
+
+/// What `render` is asked to do.
+struct RenderSettings {
+    int width = 640;
+    int height = 480;
+    /// Colour samples per pixel, on a stratified jittered grid (sampling.h). One sample is
+    /// taken at the pixel centre, unjittered.
+    int samples_per_pixel = 1;
+    /// Worker threads; 0 lets oneTBB use every core. A positive count also caps oneTBB's
+    /// process-wide parallelism while the render runs. The image does not depend on it.
+    int threads = 0;
+    /// Pixels per side of the square tiles handed to the threads.
+    int tile_size = 16;
+    /// Seeds the per-pixel sample streams.
+    std::uint64_t seed = 0;
+    /// Called from worker threads after each finished tile with the fraction done; must be
+    /// thread-safe and cheap. May be empty.
+    std::function<void(double fraction_done)> progress;
+};
+
+/// Largest width or height `render` accepts, and the most samples per pixel.
+inline constexpr int kMaxImageSize = 16384;
+inline constexpr int kMaxSamplesPerPixel = 4096;
+
+/// What a render did.
+struct RenderStats {
+    /// Camera rays: the colour samples plus, when samples_per_pixel > 1, the centre ray that
+    /// feeds the AOVs.
+    std::uint64_t primary_rays = 0;
+    std::uint64_t shadow_rays = 0;
+    double seconds = 0.0;
+
+    double million_rays_per_second() const {
+        return seconds > 0.0 ? 1e-6 * static_cast<double>(primary_rays + shadow_rays) / seconds
+                             : 0.0;
+    }
+};
+
+/// The result of `render`: the image and what it cost.
+struct RenderResult {
+    Image image;
+    RenderStats stats;
+};
+
+/// Renders a committed scene through its camera (docs/rendering.md):
+/// - primary rays through a stratified jittered grid of samples_per_pixel points per pixel;
+/// - Lambert shading, radiance = albedo / pi * sum over lights of E cos(theta), with
+///   E = intensity / distance^2 for point lights and E = radiance for directional ones, each
+///   light tested with one hard shadow ray (Scene::occluded) from an offset origin;
+/// - a scene without lights is lit from the eye instead: radiance = albedo |n . v|, and no
+///   shadow rays are cast;
+/// - the AOVs (depth, normal, object id, cost) from one counted ray through the pixel centre.
+/// Tiles are rendered in parallel with oneTBB; the image is the same for any thread count.
+/// Throws InvalidParameter for an uncommitted scene, an invalid camera, or a width, height or
+/// sample count outside [1, kMaxImageSize] / [1, kMaxSamplesPerPixel].
+RenderResult render(const Scene& scene, const RenderSettings& settings);
+
+/// Throws InvalidParameter naming the setting unless `settings` is one `render` accepts.
+void validate(const RenderSettings& settings);
+
+}  // namespace csgrt

@@ -1,0 +1,20 @@
+#include "csgrt/render/shadow_offset.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace csgrt {
+
+double ray_offset_distance(const Point3& p, double scene_magnitude) {
+    const double magnitude =
+        std::max(p.cwiseAbs().maxCoeff(), kRayOffsetSceneFraction * std::abs(scene_magnitude));
+    return kRayOffsetRelative * magnitude;
+}
+
+Point3 offset_ray_origin(const Point3& p, const Normal3& normal, double scene_magnitude) {
+    // The rounding of p + distance * normal (half an ulp of the largest coordinate per axis) is
+    // 2^-37 of the distance, so the point moves by the distance to within that.
+    return p + ray_offset_distance(p, scene_magnitude) * normal;
+}
+
+}  // namespace csgrt

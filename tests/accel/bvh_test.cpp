@@ -1,0 +1,659 @@
+#include "csgrt/accel/bvh.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <thread>
+#include <tuple>
+
+#include "csgrt/accel/brute_force.h"
+#include "csgrt/accel/factory.h"
+#include "csgrt/accel/shape_set.h"
+#include "csgrt/accel/triangle_set.h"
+#include "csgrt/core/error.h"
+#include "csgrt/core/sphere.h"
+#include "support/meshes.h"
+#include "support/random.h"
+
+namespace csgrt {
+namespace {
+
+using test::TestMesh;
+
+/// Bit-level equality of two records as the structure contract demands it: hit or miss, the
+/// same primitive (or set member) and the very same t, u and v.
+struct Answer {
+    bool hit = false;
+    std::uint64_t t_bits = 0;
+    std::uint32_t primitive = kNoIndex;
+    std::uint32_t object = kNoIndex;
+    float u = 0.0f, v = 0.0f;
+
+    static Answer of(bool hit, const HitRecord& record) {
+        if (!hit) return {};
+        return {true,
+                std::bit_cast<std::uint64_t>(record.t),
+                record.primitive,
+                record.object,
+                record.u,
+                record.v};
+    }
+    bool operator==(const Answer&) const = default;
+};
+
+std::ostream& operator<<(std::ostream& out, const Answer& a) {
+    if (!a.hit) return out << "miss";
+    return out << "t=" << std::bit_cast<double>(a.t_bits) << " primitive=" << a.primitive
+               << " object=" << a.object << " uv=(" << a.u << ", " << a.v << ")";
+}
+
+std::string describe(const Ray& ray) {
+    std::ostringstream out;
+    out.precision(17);
+    out << "o=(" << ray.origin.transpose() << ") d=(" << ray.direction.transpose() << ") ["
+        << ray.t_min << ", " << ray.t_max << "]";
+    return out.str();
+}
+
+/// Rays from outside the box toward it (camera-like), rays from inside or around it in random
+/// directions (incoherent), and a few with random sub-intervals, some starting below t = 0.
+std::vector<Ray> mixed_rays(const Aabb& box, int count, std::uint64_t seed) {
+    test::Random random(seed);
+    std::vector<Ray> rays;
+    rays.reserve(count);
+    const Aabb around = test::enlarged(box, 1.0);
+    const Aabb target = test::enlarged(box, 0.02);
+    for (int i = 0; i < count; ++i) {
+        Ray ray;
+        switch (i % 4) {
+            case 0:
+            case 1:
+                ray = random.ray_between(around, target);
+                break;
+            case 2:
+                ray.origin = random.in_box(test::enlarged(box, 0.1));
+                ray.direction = random.unit_vector() * random.uniform(0.25, 4.0);
+                break;
+            default: {
+                ray = random.ray_between(around, target);
+                const double length = around.diagonal().norm() / ray.direction.norm();
+                double a = random.uniform(-0.5, 1.5) * length,
+                       b = random.uniform(-0.5, 1.5) * length;
+                ray.t_min = std::min(a, b);
+                ray.t_max = std::max(a, b);
+                break;
+            }
+        }
+        rays.push_back(ray);
+    }
+    return rays;
+}
+
+/// Compares `structure` with `brute` on every ray: intersect (bit for bit), occluded ==
+/// intersect, and the counted entry points agree with the uncounted ones. Returns the number
+/// of rays that hit.
+template <class Set>
+int expect_same_answers(const Accelerator<Set>& structure, const Accelerator<Set>& brute,
+                        const std::vector<Ray>& rays, const std::string& label) {
+    QueryScratch scratch;
+    int hits = 0, failures = 0;
+    for (std::size_t i = 0; i < rays.size() && failures < 10; ++i) {
+        const Ray& ray = rays[i];
+        HitRecord expected_record, record, counted_record;
+        const Answer expected =
+            Answer::of(brute.intersect(ray, expected_record, scratch), expected_record);
+        const Answer actual = Answer::of(structure.intersect(ray, record, scratch), record);
+        TraversalCounters counters;
+        const Answer counted = Answer::of(
+            structure.intersect_counted(ray, counted_record, scratch, counters), counted_record);
+        const bool occluded = structure.occluded(ray, scratch);
+        const bool occluded_counted = structure.occluded_counted(ray, scratch, counters);
+        hits += expected.hit;
+        const bool ok = actual == expected && counted == expected && occluded == expected.hit &&
+                        occluded_counted == expected.hit;
+        if (!ok) {
+            ++failures;
+            ADD_FAILURE() << label << " ray " << i << ": " << describe(ray)
+                          << "\n  brute force: " << expected << "\n  structure:   " << actual
+                          << "\n  counted:     " << counted << "\n  occluded " << occluded
+                          << ", counted " << occluded_counted;
+        }
+    }
+    return hits;
+}
+
+/// A random soup of long, thin triangles crossing the unit cube in every direction.
+TestMesh thin_triangle_soup(int count, std::uint64_t seed) {
+    test::Random random(seed);
+    TestMesh mesh;
+    const Aabb cube(Point3(0, 0, 0), Point3(1, 1, 1));
+    for (int i = 0; i < count; ++i) {
+        const Point3 a = random.in_box(cube);
+        const Point3 b = random.in_box(cube);
+        const Point3 c = a + random.uniform(0.0, 0.03) * random.unit_vector();
+        const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
+        mesh.vertices.insert(mesh.vertices.end(), {a, b, c});
+        mesh.triangles.push_back({base, base + 1, base + 2});
+    }
+    return mesh;
+}
+
+/// "A teapot in a stadium": a small dense sphere mesh at the origin and a few huge triangles
+/// (a floor and two walls) a thousand times larger around it.
+TestMesh teapot_in_stadium() {
+    TestMesh mesh = test::sphere_mesh(4);
+    for (auto& vertex : mesh.vertices) vertex *= 0.1;
+    const double s = 1000.0;
+    const std::vector<Eigen::Vector3d> corners = {{-s, -1, -s}, {s, -1, -s}, {s, -1, s},
+                                                  {-s, -1, s},  {-s, s, -s}, {s, s, -s}};
+    const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), corners.begin(), corners.end());
+    for (std::array<std::uint32_t, 3> t :
+         {std::array<std::uint32_t, 3>{0, 1, 2}, {0, 2, 3}, {0, 1, 5}, {0, 5, 4}}) {
+        mesh.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+    }
+    return mesh;
+}
+
+Aabb mesh_box(const TestMesh& mesh) {
+    Aabb box;
+    for (const auto& vertex : mesh.vertices) box.extend(vertex);
+    return box;
+}
+
+template <class Real>
+class BvhMeshTest : public ::testing::Test {};
+using Precisions = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(BvhMeshTest, Precisions);
+
+TYPED_TEST(BvhMeshTest, SameHitsAsBruteForceOnEveryMeshAndLayout) {
+    // The tie rule makes the nearest hit independent of test order, so the BVH must return
+    // exactly BruteForce's primitive and t: any difference is a culled primitive (a box that
+    // was not conservative) or a traversal that stopped too early.
+    struct Case {
+        std::string name;
+        TestMesh mesh;
+        int rays;
+    };
+    std::vector<Case> cases;
+    cases.push_back({"integer_cube(8)", test::integer_cube(8), 40000});
+    cases.push_back({"sphere_mesh(5)", test::sphere_mesh(5), 20000});
+    cases.push_back({"thin soup", thin_triangle_soup(4000, 7), 20000});
+    cases.push_back({"teapot in stadium", teapot_in_stadium(), 20000});
+    int total_rays = 0;
+    for (const Case& c : cases) {
+        const TriangleSet<TypeParam> set(c.mesh.vertices, c.mesh.triangles);
+        // Box culling only makes the oracle faster: its double-precision box test (Aabb) is
+        // independent of the BVH's float one, and it returns what the plain loop returns.
+        BruteForce<TriangleSet<TypeParam>> brute;
+        brute.build(set, BruteForceConfig{.box_culling = true});
+        Aabb box = mesh_box(c.mesh);
+        // In the stadium, aim at the teapot: that is where the cost and the precision are.
+        if (c.name == "teapot in stadium")
+            box = Aabb(Point3(-0.2, -0.2, -0.2), Point3(0.2, 0.2, 0.2));
+        const std::vector<Ray> rays = mixed_rays(box, c.rays, 100 + total_rays);
+        for (int width : {8, 4, 2}) {
+            Bvh<TriangleSet<TypeParam>> bvh;
+            bvh.build(set, BvhConfig{.width = width});
+            // The other layouts share the traversal logic; a quarter of the rays suffice.
+            const std::vector<Ray> subset(rays.begin(),
+                                          rays.begin() + (width == 8 ? c.rays : c.rays / 4));
+            const int hits = expect_same_answers<TriangleSet<TypeParam>>(
+                bvh, brute, subset, c.name + " width " + std::to_string(width));
+            // A meaningful share of the rays must hit, or the comparison proves little.
+            EXPECT_GT(hits, static_cast<int>(subset.size()) / 5) << c.name;
+            if (width == 8) total_rays += static_cast<int>(subset.size());
+        }
+    }
+    EXPECT_GE(total_rays, 100000);
+}
+
+TYPED_TEST(BvhMeshTest, AllHitsEqualBruteForceAsASet) {
+    const Aabb teapot(Point3(-0.1, -0.1, -0.1), Point3(0.1, 0.1, 0.1));
+    for (const auto& [mesh, box] :
+         {std::pair{test::integer_cube(4), Aabb(Point3(0, 0, 0), Point3(4, 4, 4))},
+          std::pair{teapot_in_stadium(), teapot}}) {
+        const TriangleSet<TypeParam> set(mesh.vertices, mesh.triangles);
+        BruteForce<TriangleSet<TypeParam>> brute;
+        brute.build(set);
+        std::vector<Ray> rays = mixed_rays(box, 4000, 31);
+        // Whole lines, as CSG asks for them.
+        for (std::size_t i = 0; i < rays.size(); i += 3) {
+            rays[i].t_min = -kInfinity;
+            rays[i].t_max = kInfinity;
+        }
+        for (int width : {8, 4, 2}) {
+            Bvh<TriangleSet<TypeParam>> bvh;
+            bvh.build(set, BvhConfig{.width = width});
+            QueryScratch scratch;
+            std::size_t total = 0;
+            for (const Ray& ray : rays) {
+                std::vector<HitRecord> expected, actual;
+                brute.all_hits(ray, expected, scratch);
+                bvh.all_hits(ray, actual, scratch);
+                auto key = [](const HitRecord& r) {
+                    return std::tuple(r.primitive, std::bit_cast<std::uint64_t>(r.t), r.u, r.v);
+                };
+                std::multiset<decltype(key(expected[0]))> a, b;
+                for (const auto& r : expected) a.insert(key(r));
+                for (const auto& r : actual) b.insert(key(r));
+                ASSERT_EQ(a, b) << describe(ray);
+                total += expected.size();
+            }
+            // A closed mesh is crossed an even number of times by a whole line.
+            EXPECT_GT(total, rays.size()) << "too few hits to prove anything";
+        }
+    }
+}
+
+TEST(Bvh, ShapeSetOfTenThousandSpheres) {
+    test::Random random(5);
+    std::vector<std::shared_ptr<const Shape>> spheres;
+    for (int i = 0; i < 10000; ++i) {
+        spheres.push_back(
+            std::make_shared<Sphere>(random.in_box(Aabb(Point3(-10, -10, -10), Point3(10, 10, 10))),
+                                     random.uniform(0.05, 0.4)));
+    }
+    const ShapeSet set(spheres);
+    BruteForce<ShapeSet> brute;
+    brute.build(set);
+    Bvh<ShapeSet> bvh;
+    bvh.build(set);
+    const std::vector<Ray> rays =
+        mixed_rays(Aabb(Point3(-10, -10, -10), Point3(10, 10, 10)), 8000, 6);
+    const int hits = expect_same_answers<ShapeSet>(bvh, brute, rays, "spheres");
+    EXPECT_GT(hits, 2000);
+}
+
+TEST(Bvh, EmptySetAndSinglePrimitive) {
+    const TriangleSet<float> empty;
+    Bvh<TriangleSet<float>> bvh;
+    bvh.build(empty);
+    QueryScratch scratch;
+    HitRecord record;
+    const Ray ray{Point3(0, 0, -1), Vector3(0, 0, 1)};
+    EXPECT_FALSE(bvh.intersect(ray, record, scratch));
+    EXPECT_FALSE(bvh.occluded(ray, scratch));
+    std::vector<HitRecord> hits;
+    bvh.all_hits(ray, hits, scratch);
+    EXPECT_TRUE(hits.empty());
+    EXPECT_EQ(bvh.stats().primitives, 0u);
+
+    const std::vector<Eigen::Vector3d> vertices = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+    const std::vector<std::array<std::uint32_t, 3>> triangles = {{0, 1, 2}};
+    const TriangleSet<float> one(vertices, triangles);
+    for (int width : {2, 4, 8}) {
+        Bvh<TriangleSet<float>> single;
+        single.build(one, BvhConfig{.width = width});
+        ASSERT_TRUE(single.intersect(ray, record, scratch));
+        EXPECT_EQ(record.t, 1.0);
+        EXPECT_EQ(record.primitive, 0u);
+        EXPECT_TRUE(single.occluded(ray, scratch));
+        // The interval is honoured at both ends, and closed.
+        EXPECT_TRUE(single.occluded(Ray{ray.origin, ray.direction, 1.0, 1.0}, scratch));
+        EXPECT_FALSE(single.occluded(Ray{ray.origin, ray.direction, 0.0, 0.999}, scratch));
+        EXPECT_FALSE(single.occluded(Ray{ray.origin, ray.direction, 1.001, 5.0}, scratch));
+        EXPECT_FALSE(single.intersect(Ray{Point3(3, 0, -1), Vector3(0, 0, 1)}, record, scratch));
+    }
+}
+
+TEST(Bvh, IdenticalTrianglesShareOneLeafAndTiesGoToTheLowestIndex) {
+    // Coincident centroids cannot be binned: the builder splits at the median while a node is
+    // larger than max_leaf_size, and every answer is the lowest index.
+    const std::vector<Eigen::Vector3d> vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const std::vector<std::array<std::uint32_t, 3>> triangles(1000, {0, 1, 2});
+    const TriangleSet<float> set(vertices, triangles);
+    BruteForce<TriangleSet<float>> brute;
+    brute.build(set);
+    for (int width : {2, 4, 8}) {
+        Bvh<TriangleSet<float>> bvh;
+        bvh.build(set, BvhConfig{.width = width});
+        QueryScratch scratch;
+        HitRecord record;
+        ASSERT_TRUE(bvh.intersect(Ray{Point3(0.25, 0.25, 1), Vector3(0, 0, -1)}, record, scratch));
+        EXPECT_EQ(record.primitive, 0u);
+        std::vector<HitRecord> hits;
+        bvh.all_hits(Ray{Point3(0.25, 0.25, 1), Vector3(0, 0, -1)}, hits, scratch);
+        EXPECT_EQ(hits.size(), 1000u);
+        expect_same_answers<TriangleSet<float>>(
+            bvh, brute, mixed_rays(Aabb(Point3(0, 0, 0), Point3(1, 1, 0)), 2000, 8), "identical");
+    }
+}
+
+TEST(Bvh, FlatMeshWithParallelAndGrazingRays) {
+    // Every triangle in the plane z = 0: all boxes have zero thickness. Rays in the plane (the
+    // slab test forms 0 * inf), rays grazing it, rays along the axes with +0 and -0 components.
+    TestMesh mesh;
+    for (int i = 0; i <= 20; ++i)
+        for (int j = 0; j <= 20; ++j) mesh.vertices.emplace_back(i, j, 0.0);
+    for (std::uint32_t i = 0; i < 20; ++i) {
+        for (std::uint32_t j = 0; j < 20; ++j) {
+            const std::uint32_t a = i * 21 + j, b = a + 21, c = b + 1, d = a + 1;
+            mesh.triangles.push_back({a, b, c});
+            mesh.triangles.push_back({a, c, d});
+        }
+    }
+    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
+    BruteForce<TriangleSet<float>> brute;
+    brute.build(set);
+    std::vector<Ray> rays;
+    test::Random random(9);
+    for (int i = 0; i < 4000; ++i) {
+        const Point3 p(random.uniform(-2, 22), random.uniform(-2, 22), 0.0);
+        const double angle = random.uniform(0, kTwoPi);
+        rays.push_back(Ray{p, Vector3(std::cos(angle), std::sin(angle), 0.0)});   // in plane
+        rays.push_back(Ray{p, Vector3(std::cos(angle), std::sin(angle), -0.0)});  // -0 z
+        rays.push_back(Ray{p + Vector3(0, 0, 1e-7), Vector3(std::cos(angle), 0.3, -1e-6)});
+        rays.push_back(Ray{Point3(p.x(), p.y(), 1), Vector3(0, 0, -1)});          // axis
+        rays.push_back(Ray{Point3(p.x(), p.y(), -1), Vector3(0.0, -0.0, 2.0)});   // axis
+        rays.push_back(Ray{Point3(std::round(p.x()), -1, 0), Vector3(0, 1, 0)});  // on edges
+    }
+    for (int width : {2, 4, 8}) {
+        Bvh<TriangleSet<float>> bvh;
+        bvh.build(set, BvhConfig{.width = width});
+        const int hits = expect_same_answers<TriangleSet<float>>(bvh, brute, rays, "flat");
+        EXPECT_GT(hits, 8000);
+    }
+}
+
+TEST(Bvh, InvalidAndExtremeRays) {
+    const TestMesh mesh = test::sphere_mesh(3);
+    const TriangleSet<double> set(mesh.vertices, mesh.triangles);
+    BruteForce<TriangleSet<double>> brute;
+    brute.build(set);
+    Bvh<TriangleSet<double>> bvh;
+    bvh.build(set);
+    QueryScratch scratch;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (const Ray& ray :
+         {Ray{Point3(nan, 0, 0), Vector3(1, 0, 0)}, Ray{Point3(0, 0, 0), Vector3(nan, 1, 0)},
+          Ray{Point3(kInfinity, 0, 0), Vector3(-1, 0, 0)}, Ray{Point3(0, 0, 0), Vector3(0, 0, 0)},
+          Ray{Point3(0, 0, 0), Vector3(kInfinity, 0, 0)},
+          Ray{Point3(0, 0, 0), Vector3(1, 0, 0), 2.0, 1.0},
+          Ray{Point3(0, 0, 0), Vector3(1, 0, 0), nan, 1.0}}) {
+        HitRecord record;
+        EXPECT_FALSE(bvh.intersect(ray, record, scratch)) << describe(ray);
+        EXPECT_FALSE(bvh.occluded(ray, scratch)) << describe(ray);
+        std::vector<HitRecord> hits;
+        bvh.all_hits(ray, hits, scratch);
+        EXPECT_TRUE(hits.empty()) << describe(ray);
+    }
+    // Rays the float box test cannot represent (far origins, huge or tiny directions) are
+    // answered by visiting everything: slow, but still exactly brute force's answer.
+    std::vector<Ray> extreme;
+    test::Random random(10);
+    for (int i = 0; i < 500; ++i) {
+        const Vector3 towards =
+            random.in_box(Aabb(Point3(-0.5, -0.5, -0.5), Point3(0.5, 0.5, 0.5)));
+        const Vector3 direction = random.unit_vector();
+        extreme.push_back(
+            Ray{towards - 1e35 * direction, 1e-36 * direction.normalized(), 0.0, kInfinity});
+        extreme.push_back(Ray{towards - 3.0 * direction, 1e40 * direction, 0.0, kInfinity});
+        extreme.push_back(Ray{towards - 3.0 * direction, 1e-40 * direction, 0.0, kInfinity});
+        extreme.push_back(Ray{towards, Vector3(direction.x(), 1e-45, 0.0), -kInfinity, kInfinity});
+    }
+    expect_same_answers<TriangleSet<double>>(bvh, brute, extreme, "extreme");
+}
+
+/// Checks the binary tree's invariants: each primitive referenced once, each node's box
+/// containing its children's boxes and its primitives' boxes.
+template <class Set>
+void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
+    const auto& indices = bvh.primitive_indices();
+    std::vector<int> references(set.size(), 0);
+    for (std::uint32_t index : indices) {
+        ASSERT_LT(index, set.size());
+        ++references[index];
+    }
+    EXPECT_TRUE(std::all_of(references.begin(), references.end(), [](int r) { return r == 1; }));
+
+    auto contains = [](const float* lower, const float* upper, const Aabb& box) {
+        for (int axis = 0; axis < 3; ++axis) {
+            if (!(lower[axis] <= box.lower[axis] && box.upper[axis] <= upper[axis])) return false;
+        }
+        return true;
+    };
+    auto leaf_ok = [&](const float* lower, const float* upper, std::uint32_t first,
+                       std::uint32_t count) {
+        for (std::uint32_t i = first; i < first + count; ++i) {
+            if (!contains(lower, upper, set.bounds(indices[i]))) return false;
+        }
+        return true;
+    };
+    std::size_t leaf_references = 0;
+    if (width == 2) {
+        const auto& nodes = bvh.binary_nodes();
+        ASSERT_FALSE(nodes.empty());
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+            if (i == 1) continue;
+            const BvhNode& node = nodes[i];
+            if (node.is_leaf()) {
+                EXPECT_TRUE(leaf_ok(node.lower, node.upper, node.offset, node.count)) << i;
+                leaf_references += node.count;
+                continue;
+            }
+            ASSERT_EQ(node.offset % 2, 0u);  // sibling pairs share a cache line
+            for (std::uint32_t child = node.offset; child < node.offset + 2; ++child) {
+                const BvhNode& c = nodes[child];
+                EXPECT_TRUE(contains(node.lower, node.upper,
+                                     Aabb(Point3(c.lower[0], c.lower[1], c.lower[2]),
+                                          Point3(c.upper[0], c.upper[1], c.upper[2]))))
+                    << i << " " << child;
+            }
+        }
+    } else {
+        auto check_wide = [&](const auto& nodes) {
+            constexpr int kChildren = std::decay_t<decltype(nodes[0])>::kChildren;
+            constexpr std::uint32_t kInterior = Bvh4Node::kInterior;
+            ASSERT_FALSE(nodes.empty());
+            // Through the leaves, each primitive must be reached exactly once.
+            std::vector<int> reached(set.size(), 0);
+            for (std::size_t i = 0; i < nodes.size(); ++i) {
+                const auto& node = nodes[i];
+                for (int slot = 0; slot < kChildren; ++slot) {
+                    const float lower[3] = {node.bounds[0][slot], node.bounds[2][slot],
+                                            node.bounds[4][slot]};
+                    const float upper[3] = {node.bounds[1][slot], node.bounds[3][slot],
+                                            node.bounds[5][slot]};
+                    if (node.count[slot] == 1) {
+                        // A one-primitive leaf names its primitive directly.
+                        ASSERT_LT(node.first[slot], set.size());
+                        EXPECT_TRUE(contains(lower, upper, set.bounds(node.first[slot]))) << i;
+                        ++reached[node.first[slot]];
+                        ++leaf_references;
+                        continue;
+                    }
+                    if (node.count[slot] != kInterior) {
+                        EXPECT_TRUE(leaf_ok(lower, upper, node.first[slot], node.count[slot])) << i;
+                        for (std::uint32_t k = 0; k < node.count[slot]; ++k)
+                            ++reached[indices[node.first[slot] + k]];
+                        leaf_references += node.count[slot];
+                        continue;
+                    }
+                    ASSERT_GT(node.first[slot], i);  // children follow their parent
+                    const auto& child = nodes[node.first[slot]];
+                    for (int s = 0; s < kChildren; ++s) {
+                        if (child.bounds[0][s] > child.bounds[1][s]) continue;  // unused slot
+                        EXPECT_TRUE(contains(
+                            lower, upper,
+                            Aabb(Point3(child.bounds[0][s], child.bounds[2][s], child.bounds[4][s]),
+                                 Point3(child.bounds[1][s], child.bounds[3][s],
+                                        child.bounds[5][s]))))
+                            << i << " slot " << slot;
+                    }
+                }
+            }
+            EXPECT_TRUE(std::all_of(reached.begin(), reached.end(), [](int r) { return r == 1; }));
+        };
+        if (width == 4) check_wide(bvh.nodes_4_wide());
+        if (width == 8) check_wide(bvh.nodes_8_wide());
+    }
+    EXPECT_EQ(leaf_references, set.size());
+}
+
+TEST(Bvh, TreeInvariantsAndStats) {
+    const TestMesh mesh = test::sphere_mesh(6);
+    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
+    for (int width : {2, 4, 8}) {
+        Bvh<TriangleSet<float>> bvh;
+        bvh.build(set, BvhConfig{.width = width});
+        expect_valid_tree(bvh, set, width);
+        const AcceleratorStats stats = bvh.stats();
+        EXPECT_EQ(stats.name, "bvh");
+        EXPECT_EQ(stats.primitives, set.size());
+        EXPECT_EQ(stats.references, set.size());
+        EXPECT_GT(stats.nodes, set.size() / 16);
+        EXPECT_GE(stats.build_milliseconds, 0.0);
+        EXPECT_FALSE(stats.details.empty());
+        // The memory target: nodes and indices within 80 bytes a triangle (the triangles
+        // themselves, 36 bytes each in float, are the set's).
+        EXPECT_LE(double(stats.bytes) / double(set.size()), 80.0) << stats.details;
+    }
+    // Other sets and configurations keep the invariants too.
+    const TestMesh stadium = teapot_in_stadium();
+    const TriangleSet<double> stadium_set(stadium.vertices, stadium.triangles);
+    for (int bins : {2, 7, 32}) {
+        Bvh<TriangleSet<double>> bvh;
+        bvh.build(stadium_set, BvhConfig{.bins = bins, .max_leaf_size = 1, .width = 8});
+        expect_valid_tree(bvh, stadium_set, 8);
+    }
+}
+
+TEST(Bvh, ParallelAndSerialBuildsMakeTheSameTree) {
+    const TestMesh mesh = thin_triangle_soup(100000, 12);
+    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
+    Bvh<TriangleSet<float>> serial, parallel;
+    serial.build(set, BvhConfig{.width = 2, .parallel = false});
+    parallel.build(set, BvhConfig{.width = 2, .parallel = true});
+    EXPECT_EQ(serial.stats().nodes, parallel.stats().nodes);
+    EXPECT_EQ(serial.stats().details, parallel.stats().details);
+    // The same topology gives the same work, ray by ray.
+    QueryScratch scratch;
+    for (const Ray& ray : mixed_rays(Aabb(Point3(0, 0, 0), Point3(1, 1, 1)), 500, 13)) {
+        TraversalCounters a, b;
+        HitRecord ra, rb;
+        EXPECT_EQ(serial.intersect_counted(ray, ra, scratch, a),
+                  parallel.intersect_counted(ray, rb, scratch, b));
+        EXPECT_EQ(a.nodes_visited, b.nodes_visited);
+        EXPECT_EQ(a.primitives_tested, b.primitives_tested);
+    }
+}
+
+TEST(Bvh, PathologicalSpacingStaysWithinTheDepthBound) {
+    // Triangles at x = 3^k, binned into 2 bins: only the largest lies in the upper bin, so
+    // every binned split peels off one triangle and, without the depth limit, the tree would
+    // be 158 levels deep, beyond what the traversal stack holds.
+    TestMesh mesh;
+    for (int k = -79; k <= 79; ++k) {
+        const double x = std::pow(3.0, k);
+        const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
+        mesh.vertices.insert(mesh.vertices.end(), {{x, 0, 0}, {x, 1, 0}, {x, 0, 1}});
+        mesh.triangles.push_back({base, base + 1, base + 2});
+    }
+    const TriangleSet<double> set(mesh.vertices, mesh.triangles);
+    BruteForce<TriangleSet<double>> brute;
+    brute.build(set);
+    for (int width : {2, 4, 8}) {
+        Bvh<TriangleSet<double>> bvh;
+        bvh.build(set, BvhConfig{.bins = 2, .max_leaf_size = 1, .width = width});
+        const std::string details = bvh.stats().details;
+        const int depth = std::stoi(details.substr(details.find("depth ") + 6));
+        EXPECT_LE(depth, detail::kMaxDepth) << details;
+        EXPECT_GT(depth, detail::kMaxSahDepth) << details;  // the limit was reached
+        std::vector<Ray> rays;
+        test::Random random(14);
+        for (int i = 0; i < 2000; ++i) {
+            const Point3 p(std::pow(3.0, random.uniform(-80, 80)), random.uniform(0, 0.5),
+                           random.uniform(0, 0.5));
+            rays.push_back(Ray{p + Vector3(0, 0, 5), Vector3(random.uniform(-1, 1), 0, -1)});
+            rays.push_back(Ray{Point3(-1, p.y(), p.z()), Vector3(1, 0, 0)});
+        }
+        expect_same_answers<TriangleSet<double>>(bvh, brute, rays, "spacing");
+    }
+}
+
+TEST(Bvh, CountedQueriesDoFarLessWorkThanBruteForce) {
+    // sphere_mesh(6): 32768 triangles. Brute force tests all of them per ray; the 8-wide BVH
+    // visits about 8 nodes (leaves included) and tests about 2.6 triangles per ray here
+    // (measured), so nodes + triangles per ray must stay under 1/1000 of brute force's
+    // triangle tests (about 10 against 33: a factor 3 of headroom).
+    const TestMesh mesh = test::sphere_mesh(6);
+    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
+    Bvh<TriangleSet<float>> bvh;
+    bvh.build(set);
+    BruteForce<TriangleSet<float>> brute;
+    brute.build(set);
+    QueryScratch scratch;
+    test::Random random(15);
+    TraversalCounters tree, naive;
+    const int rays = 2000;
+    for (int i = 0; i < rays; ++i) {
+        const Ray ray = random.ray_between(Aabb(Point3(-4, -4, -4), Point3(4, 4, 4)),
+                                           Aabb(Point3(-1, -1, -1), Point3(1, 1, 1)));
+        HitRecord a, b;
+        ASSERT_EQ(bvh.intersect_counted(ray, a, scratch, tree),
+                  brute.intersect_counted(ray, b, scratch, naive));
+    }
+    EXPECT_EQ(naive.primitives_tested, std::uint64_t(rays) * set.size());
+    EXPECT_GE(tree.nodes_visited, std::uint64_t(rays));  // at least the root, every ray
+    EXPECT_EQ(tree.boxes_tested % 4, 0u);                // four boxes per 4-wide node
+    EXPECT_LT((tree.nodes_visited + tree.primitives_tested) * 1000, naive.primitives_tested);
+}
+
+TEST(Bvh, ConcurrentQueriesGiveTheSameAnswers) {
+    const TestMesh mesh = test::sphere_mesh(5);
+    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
+    Bvh<TriangleSet<float>> bvh;
+    bvh.build(set);
+    const std::vector<Ray> rays = mixed_rays(mesh_box(mesh), 20000, 16);
+    std::vector<Answer> expected(rays.size());
+    QueryScratch scratch;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        HitRecord record;
+        expected[i] = Answer::of(bvh.intersect(rays[i], record, scratch), record);
+    }
+    std::vector<int> mismatches(4, 0);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 4; ++t) {
+        threads.emplace_back([&, t] {
+            QueryScratch own;
+            for (std::size_t i = t; i < rays.size(); i += 2) {
+                HitRecord record;
+                const Answer answer = Answer::of(bvh.intersect(rays[i], record, own), record);
+                mismatches[t] += !(answer == expected[i]);
+                mismatches[t] += bvh.occluded(rays[i], own) != expected[i].hit;
+            }
+        });
+    }
+    for (auto& thread : threads) thread.join();
+    EXPECT_EQ(mismatches, std::vector<int>(4, 0));
+}
+
+TEST(Bvh, BadConfigsThrowAndTheFactoryBuildsIt) {
+    const TestMesh mesh = test::integer_cube(2);
+    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
+    Bvh<TriangleSet<float>> bvh;
+    EXPECT_THROW(bvh.build(set, BvhConfig{.bins = 1}), InvalidParameter);
+    EXPECT_THROW(bvh.build(set, BvhConfig{.bins = 257}), InvalidParameter);
+    EXPECT_THROW(bvh.build(set, BvhConfig{.max_leaf_size = 0}), InvalidParameter);
+    EXPECT_THROW(bvh.build(set, BvhConfig{.traversal_cost = 0.0}), InvalidParameter);
+    EXPECT_THROW(bvh.build(set, BvhConfig{.intersection_cost = -1.0}), InvalidParameter);
+    EXPECT_THROW(bvh.build(set, BvhConfig{.width = 3}), InvalidParameter);
+
+    const auto names = accelerator_names();
+    EXPECT_NE(std::find(names.begin(), names.end(), "bvh"), names.end());
+    const auto structure = make_accelerator("bvh", set);
+    EXPECT_EQ(structure->name(), "bvh");
+    QueryScratch scratch;
+    HitRecord record;
+    ASSERT_TRUE(structure->intersect(Ray{Point3(1, 1, 5), Vector3(0, 0, -1)}, record, scratch));
+    EXPECT_EQ(record.t, 3.0);
+}
+
+}  // namespace
+}  // namespace csgrt

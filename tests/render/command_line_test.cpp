@@ -1,0 +1,319 @@
+#include "csgrt/render/command_line.h"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "csgrt/accel/factory.h"
+#include "csgrt/render/exr.h"
+
+namespace csgrt {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_directory(const std::string& name) {
+    const fs::path path = fs::path(CSGRT_BINARY_DIR) / "test_output" / name;
+    fs::remove_all(path);
+    fs::create_directories(path);
+    return path;
+}
+
+std::vector<std::string> names_in(const fs::path& directory) {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(directory)) {
+        names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+/// A small scene: a ground plane, a CSG difference, and an instanced sphere in a union.
+constexpr const char* kSceneText = R"({
+  "camera": {"position": [0, 2, 6], "look_at": [0, 0.5, 0]},
+  "materials": {"red": {"albedo": [0.8, 0.2, 0.2]}},
+  "lights": [{"type": "point", "position": [3, 5, 4], "intensity": [120, 120, 120]},
+             {"type": "directional", "direction": [0, -1, 0]}],
+  "objects": [
+    {"type": "plane", "normal": [0, 1, 0]},
+    {"type": "difference", "material": "red", "operands": [
+        {"type": "box", "lower": [-1, 0, -1], "upper": [1, 2, 1]},
+        {"type": "sphere", "center": [0, 2, 0], "radius": 1.2}]},
+    {"type": "union", "operands": [
+        {"type": "sphere", "radius": 0.4, "transform": [{"translate": [2, 0.4, 0]}]},
+        {"type": "sphere", "center": [2, 0.9, 0], "radius": 0.3}]}
+  ]
+})";
+
+struct ProgramRun {
+    int status;
+    std::string out;
+    std::string err;
+};
+
+ProgramRun run(std::vector<std::string> arguments) {
+    arguments.insert(arguments.begin(), "csgrt");
+    std::vector<const char*> argv;
+    for (const std::string& argument : arguments) argv.push_back(argument.c_str());
+    std::ostringstream out, err;
+    const int status =
+        run_csgrt(static_cast<int>(argv.size()), argv.data(), CommandLineStreams{out, err});
+    return {status, out.str(), err.str()};
+}
+
+/// An error run: exit status 1, nothing on stdout, exactly one line on stderr that starts
+/// with "csgrt: error: " and contains `fragment`.
+void expect_one_line_error(const ProgramRun& result, const std::string& fragment) {
+    EXPECT_EQ(result.status, 1);
+    EXPECT_EQ(result.out, "");
+    ASSERT_FALSE(result.err.empty());
+    EXPECT_EQ(result.err.rfind("csgrt: error: ", 0), 0u) << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_EQ(result.err.back(), '\n');
+    EXPECT_NE(result.err.find(fragment), std::string::npos)
+        << "\"" << fragment << "\" not in: " << result.err;
+}
+
+class CommandLine : public ::testing::Test {
+protected:
+    void SetUp() override {
+        directory_ = fresh_directory(
+            std::string("cli_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        scene_ = (directory_ / "scene.json").string();
+        std::ofstream(scene_) << kSceneText;
+        output_ = (directory_ / "out.exr").string();
+    }
+    /// Only the scene file: no output, complete or partial, was left behind.
+    void expect_no_output() const {
+        EXPECT_EQ(names_in(directory_), std::vector<std::string>{"scene.json"});
+    }
+
+    fs::path directory_;
+    std::string scene_;
+    std::string output_;
+};
+
+TEST_F(CommandLine, RenderWritesTheExrAndPreviewsAndOneSummaryLine) {
+    const ProgramRun result = run({"render", scene_, "-o", output_, "--width", "40", "--height",
+                                   "30", "--spp", "4", "--threads", "2"});
+    ASSERT_EQ(result.status, 0) << result.err;
+    EXPECT_EQ(result.err, "");  // not a terminal: no progress bar
+    EXPECT_EQ(std::count(result.out.begin(), result.out.end(), '\n'), 1) << result.out;
+    for (const char* fragment : {"40x30", "4 spp", "Mrays/s", "primary", "shadow rays",
+                                 "structure brute", "built in", "out.exr", "out.cost.png"}) {
+        EXPECT_NE(result.out.find(fragment), std::string::npos) << fragment << ": " << result.out;
+    }
+    EXPECT_EQ(names_in(directory_),
+              (std::vector<std::string>{"out.cost.png", "out.exr", "out.png", "scene.json"}));
+    const ExrFile file = read_exr(output_);
+    EXPECT_EQ(file.image.width(), 40);
+    EXPECT_EQ(file.image.height(), 30);
+    EXPECT_EQ(file.metadata.accelerator, "brute");
+    EXPECT_EQ(file.metadata.samples_per_pixel, 4);
+    EXPECT_EQ(file.metadata.scene, "scene.json");
+    EXPECT_EQ(file.metadata.camera.position, Point3(0, 2, 6));
+    // The scene's three objects all show up in the id channel.
+    std::vector<bool> seen(3, false);
+    for (const Pixel& pixel : file.image.pixels()) {
+        if (pixel.object_id < 3) seen[pixel.object_id] = true;
+    }
+    EXPECT_EQ(seen, std::vector<bool>(3, true));
+}
+
+TEST_F(CommandLine, EveryAvailableStructureRendersTheSameImage) {
+    ASSERT_EQ(run({"render", scene_, "-o", output_, "--width", "32", "--height", "24", "--accel",
+                   "brute"})
+                  .status,
+              0);
+    const ExrFile reference = read_exr(output_);
+    for (std::string_view name : accelerator_names()) {
+        const std::string other = (directory_ / (std::string(name) + ".exr")).string();
+        ASSERT_EQ(run({"render", scene_, "-o", other, "--width", "32", "--height", "24", "--accel",
+                       std::string(name)})
+                      .status,
+                  0)
+            << name;
+        const ExrFile file = read_exr(other);
+        EXPECT_EQ(file.metadata.accelerator, name);
+        for (std::size_t i = 0; i < file.image.pixel_count(); ++i) {
+            const Pixel& a = reference.image.pixels()[i];
+            const Pixel& b = file.image.pixels()[i];
+            ASSERT_EQ(a.depth, b.depth) << name;
+            ASSERT_EQ(a.object_id, b.object_id) << name;
+            ASSERT_EQ(a.red, b.red) << name;
+        }
+    }
+}
+
+TEST_F(CommandLine, BadArgumentsGiveOneLineAndNoFiles) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{}, "subcommand is required"},
+        {{"draw", scene_}, "draw"},
+        {{"render", scene_}, "--output is required"},
+        {{"render", "-o", output_}, "scene is required"},
+        {{"render", scene_, "-o", output_, "--width", "0"}, "--width must be in [1, 16384]"},
+        {{"render", scene_, "-o", output_, "--height", "16385"}, "--height must be in"},
+        {{"render", scene_, "-o", output_, "--width", "-7"}, "--width"},
+        {{"render", scene_, "-o", output_, "--width", "abc"}, "--width"},
+        {{"render", scene_, "-o", output_, "--width", "99999999999"}, "--width"},
+        {{"render", scene_, "-o", output_, "--spp", "0"}, "--spp must be in [1, 4096]"},
+        {{"render", scene_, "-o", output_, "--spp", "4097"}, "--spp must be in [1, 4096]"},
+        {{"render", scene_, "-o", output_, "--threads", "-1"}, "--threads"},
+        {{"render", scene_, "-o", output_, "--accel", "octree"}, "unknown structure"},
+        {{"render", scene_, "-o", output_, "--bogus"}, "--bogus"},
+        {{"render", (directory_ / "missing.json").string(), "-o", output_}, "missing.json"},
+        {{"render", directory_.string(), "-o", output_}, "is a directory"},
+        {{"render", scene_, "-o", (directory_ / "no" / "out.exr").string()}, "does not exist"},
+        {{"render", scene_, "-o", (directory_ / "out.png").string()}, "must end in .exr"},
+        {{"info"}, "scene is required"},
+        {{"validate", (directory_ / "missing.json").string()}, "does not exist"},
+    };
+    for (const auto& [arguments, fragment] : cases) {
+        SCOPED_TRACE(::testing::PrintToString(arguments));
+        expect_one_line_error(run(arguments), fragment);
+    }
+    expect_no_output();
+}
+
+TEST_F(CommandLine, StructuresNamedButNotBuiltAreReportedAsUnavailable) {
+    const auto names = accelerator_names();
+    int checked = 0;
+    for (const char* name : {"bvh", "grid", "hgrid", "rayclass"}) {
+        if (std::find(names.begin(), names.end(), name) != names.end()) continue;
+        expect_one_line_error(run({"render", scene_, "-o", output_, "--accel", name}),
+                              "not available in this build");
+        ++checked;
+    }
+    expect_no_output();
+    if (checked == 0) GTEST_SKIP() << "every documented structure is registered";
+}
+
+TEST_F(CommandLine, ABrokenSceneFileIsOneLineNamingTheFileAndWritesNothing) {
+    const std::string broken = (directory_ / "broken.json").string();
+    std::ofstream(broken) << R"({"objects": [{"type": "sphere", "radius": -1}]})";
+    const ProgramRun rendered = run({"render", broken, "-o", output_});
+    expect_one_line_error(rendered, "broken.json");
+    expect_one_line_error(rendered, "radius");
+    expect_one_line_error(run({"validate", broken}), "/objects/0/radius");
+    expect_one_line_error(run({"info", broken}), "broken.json");
+    fs::remove(broken);
+    expect_no_output();
+}
+
+TEST_F(CommandLine, AnOutputThatIsADirectoryIsRefusedBeforeRendering) {
+    fs::create_directory(directory_ / "out.png");
+    expect_one_line_error(run({"render", scene_, "-o", output_}), "is a directory");
+    EXPECT_EQ(names_in(directory_), (std::vector<std::string>{"out.png", "scene.json"}));
+}
+
+TEST_F(CommandLine, TheProgressBarAppearsOnATerminalOnlyAfterTheDelay) {
+    auto run_on_terminal = [&](bool terminal, double delay) {
+        const std::vector<std::string> arguments = {"csgrt",   "render", scene_,     "-o", output_,
+                                                    "--width", "64",     "--height", "48"};
+        std::vector<const char*> argv;
+        for (const std::string& argument : arguments) argv.push_back(argument.c_str());
+        std::ostringstream out, err;
+        EXPECT_EQ(run_csgrt(static_cast<int>(argv.size()), argv.data(),
+                            CommandLineStreams{out, err, terminal, delay}),
+                  0);
+        return err.str();
+    };
+    // The default delay (a second) is far longer than this render: silent.
+    EXPECT_EQ(run_on_terminal(true, 1.0), "");
+    // Not a terminal: silent whatever the delay.
+    EXPECT_EQ(run_on_terminal(false, 0.0), "");
+    // No delay: the bar is drawn, then its line is cleared for the summary.
+    const std::string err = run_on_terminal(true, 0.0);
+    EXPECT_NE(err.find("["), std::string::npos) << err;
+    EXPECT_NE(err.find("%"), std::string::npos) << err;
+    EXPECT_EQ(err.back(), '\r');
+    EXPECT_EQ(err.find('\n'), std::string::npos);
+}
+
+TEST_F(CommandLine, ValidatePrintsNothingForAGoodScene) {
+    const ProgramRun result = run({"validate", scene_});
+    EXPECT_EQ(result.status, 0);
+    EXPECT_EQ(result.out, "");
+    EXPECT_EQ(result.err, "");
+}
+
+TEST_F(CommandLine, InfoCountsKindsThroughTheTree) {
+    const ProgramRun result = run({"info", scene_});
+    ASSERT_EQ(result.status, 0) << result.err;
+    // plane; difference(box, sphere); union(instance(sphere), sphere): 8 shapes.
+    for (const char* fragment :
+         {"3 top-level (1 unbounded), 8 shapes", "  box                1\n",
+          "  difference         1\n", "  instance           1\n", "  plane              1\n",
+          "  sphere             3\n", "  union              1\n", "2 (1 point, 1 directional)",
+          "pinhole at (0, 2, 6)", "structure:  brute (auto: 2 bounded members"}) {
+        EXPECT_NE(result.out.find(fragment), std::string::npos)
+            << "\"" << fragment << "\" not in:\n"
+            << result.out;
+    }
+}
+
+TEST_F(CommandLine, InfoReportsTheShowcasesMeshWithItsTriangleCount) {
+    // The triangle count from the OFF file's header ("OFF", then vertices faces edges), read
+    // here independently of the mesh loader; the knot is all triangles.
+    const fs::path scenes = fs::path(CSGRT_SOURCE_DIR) / "data" / "scenes";
+    std::ifstream off(scenes / "meshes" / "trefoil.off");
+    std::string magic;
+    std::size_t vertices = 0, faces = 0;
+    off >> magic >> vertices >> faces;
+    ASSERT_EQ(magic, "OFF");
+    ASSERT_GT(faces, 100u);
+    const ProgramRun result = run({"info", (scenes / "showcase.json").string()});
+    ASSERT_EQ(result.status, 0) << result.err;
+    EXPECT_NE(result.out.find("  mesh               1 (" + std::to_string(faces) +
+                              " triangles in all)\n"),
+              std::string::npos)
+        << result.out;
+}
+
+TEST_F(CommandLine, HelpAndVersionSucceed) {
+    const ProgramRun help = run({"--help"});
+    EXPECT_EQ(help.status, 0);
+    for (const char* fragment : {"render", "info", "validate", "Examples:"}) {
+        EXPECT_NE(help.out.find(fragment), std::string::npos) << fragment;
+    }
+    const ProgramRun render_help = run({"render", "--help"});
+    EXPECT_EQ(render_help.status, 0);
+    for (const char* fragment : {"--width", "--spp", "--threads", "--accel", "auto", "cost"}) {
+        EXPECT_NE(render_help.out.find(fragment), std::string::npos) << fragment;
+    }
+    const ProgramRun version = run({"--version"});
+    EXPECT_EQ(version.status, 0);
+    EXPECT_EQ(version.out.rfind("csgrt ", 0), 0u);
+}
+
+TEST_F(CommandLine, TheProgramExitsWithStatusOneOnBadInput) {
+    // The real binary, not the in-process entry point: exit statuses as a shell sees them.
+    const fs::path program = fs::path(CSGRT_BINARY_DIR) / "render" / "csgrt";
+    ASSERT_TRUE(fs::exists(program)) << program << " is built with the tests";
+    auto status_of = [&](const std::string& arguments) {
+        const std::string command = program.string() + " " + arguments + " 2>" +
+                                    (directory_ / "stderr.txt").string() + " >/dev/null";
+        const int raw = std::system(command.c_str());
+        fs::remove(directory_ / "stderr.txt");
+        return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    };
+    EXPECT_EQ(status_of("render " + scene_ + " -o " + output_ + " --width 0"), 1);
+    EXPECT_EQ(status_of("render " + scene_ + " -o " + output_ + " --accel nope"), 1);
+    EXPECT_EQ(status_of("validate " + (directory_ / "none.json").string()), 1);
+    EXPECT_EQ(status_of(""), 1);
+    expect_no_output();
+    EXPECT_EQ(status_of("validate " + scene_), 0);
+    EXPECT_EQ(status_of("--help"), 0);
+    EXPECT_EQ(status_of("render " + scene_ + " -o " + output_ + " --width 8 --height 8"), 0);
+    EXPECT_TRUE(fs::exists(output_));
+}
+
+}  // namespace
+}  // namespace csgrt

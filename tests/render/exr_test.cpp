@@ -1,0 +1,237 @@
+#include "csgrt/render/exr.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDoubleAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfStandardAttributes.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfVecAttribute.h>
+#include <gtest/gtest.h>
+
+#include <Imath/half.h>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace csgrt {
+namespace {
+
+std::filesystem::path fresh_directory(const std::string& name) {
+    const std::filesystem::path path =
+        std::filesystem::path(CSGRT_BINARY_DIR) / "test_output" / name;
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+    return path;
+}
+
+std::vector<std::string> names_in(const std::filesystem::path& directory) {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(directory)) {
+        names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+/// A 5 x 3 image whose every channel varies per pixel, with background pixels mixed in.
+Image sample_image() {
+    Image image(5, 3);
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 5; ++x) {
+            Pixel& pixel = image.at(x, y);
+            if ((x + y) % 4 == 3) {
+                pixel.cost = 2.0f;  // background: default depth, normal and id
+                continue;
+            }
+            pixel.red = 0.1f * x + 0.3337f;
+            pixel.green = 1.0f / (y + 3.0f);
+            pixel.blue = 12.5f;  // above 1: HDR values survive
+            pixel.alpha = 1.0f;
+            pixel.depth = 1.0f + 0.123456789f * (x + 5 * y);
+            const Vector3 n = Vector3(x - 2.0, y - 1.0, 1.5).normalized();
+            pixel.normal_x = float(n.x());
+            pixel.normal_y = float(n.y());
+            pixel.normal_z = float(n.z());
+            pixel.object_id = 1000000u * x + 7u * y;  // beyond float's exact integers
+            pixel.cost = float(17 * x + y);
+        }
+    }
+    return image;
+}
+
+ExrMetadata sample_metadata() {
+    ExrMetadata metadata;
+    metadata.camera.position = Point3(1, 2, 10);
+    metadata.camera.look_at = Point3(1, 2, 0);
+    metadata.camera.up = Vector3(0, 1, 0);
+    metadata.camera.vertical_fov_degrees = 35.0;
+    metadata.accelerator = "brute";
+    metadata.accelerator_build_milliseconds = 1.25;
+    metadata.samples_per_pixel = 16;
+    metadata.scene = "sample.json";
+    return metadata;
+}
+
+TEST(WriteExr, WritesTheDocumentedChannelsAndAttributes) {
+    const auto directory = fresh_directory("exr_channels");
+    const Image image = sample_image();
+    write_exr(directory / "out.exr", image, sample_metadata());
+    // Nothing but the file itself is left behind.
+    EXPECT_EQ(names_in(directory), std::vector<std::string>{"out.exr"});
+
+    // Read with OpenEXR directly, independently of read_exr.
+    Imf::InputFile file((directory / "out.exr").c_str());
+    const Imf::Header& header = file.header();
+    const Imf::ChannelList& channels = header.channels();
+    const std::vector<std::pair<std::string, Imf::PixelType>> expected = {
+        {"A", Imf::HALF},     {"B", Imf::HALF},    {"G", Imf::HALF}, {"N.X", Imf::FLOAT},
+        {"N.Y", Imf::FLOAT},  {"N.Z", Imf::FLOAT}, {"R", Imf::HALF}, {"Z", Imf::FLOAT},
+        {"cost", Imf::FLOAT}, {"id", Imf::UINT}};
+    std::vector<std::pair<std::string, Imf::PixelType>> found;
+    for (auto it = channels.begin(); it != channels.end(); ++it) {
+        found.emplace_back(it.name(), it.channel().type);
+    }
+    EXPECT_EQ(found, expected);  // ChannelList iterates in name order
+
+    const Imath::Box2i window = header.dataWindow();
+    EXPECT_EQ(window.min, Imath::V2i(0, 0));
+    EXPECT_EQ(window.max, Imath::V2i(4, 2));
+    EXPECT_EQ(header.typedAttribute<Imf::V2iAttribute>("resolution").value(), Imath::V2i(5, 3));
+    EXPECT_EQ(header.typedAttribute<Imf::StringAttribute>("cameraProjection").value(), "pinhole");
+    EXPECT_EQ(header.typedAttribute<Imf::V3dAttribute>("cameraPosition").value(),
+              Imath::V3d(1, 2, 10));
+    EXPECT_EQ(header.typedAttribute<Imf::DoubleAttribute>("cameraVerticalFov").value(), 35.0);
+    EXPECT_EQ(header.typedAttribute<Imf::StringAttribute>("accelerator").value(), "brute");
+    EXPECT_EQ(header.typedAttribute<Imf::DoubleAttribute>("acceleratorBuildMs").value(), 1.25);
+    EXPECT_EQ(header.typedAttribute<Imf::IntAttribute>("samplesPerPixel").value(), 16);
+    EXPECT_EQ(header.typedAttribute<Imf::StringAttribute>("scene").value(), "sample.json");
+    // worldToCamera (row vectors, camera looking along +z): the camera sits at the origin, the
+    // point looked at is 10 ahead, and a point to the world's +x is to the camera's right.
+    ASSERT_TRUE(Imf::hasWorldToCamera(header));
+    const Imath::M44f& world_to_camera = Imf::worldToCamera(header);
+    const Imath::V3f at_camera = Imath::V3f(1, 2, 10) * world_to_camera;
+    const Imath::V3f ahead = Imath::V3f(1, 2, 0) * world_to_camera;
+    const Imath::V3f right = Imath::V3f(2, 2, 10) * world_to_camera;
+    EXPECT_LT(at_camera.length(), 1e-6f);
+    EXPECT_LT((ahead - Imath::V3f(0, 0, 10)).length(), 1e-5f);
+    EXPECT_LT((right - Imath::V3f(1, 0, 0)).length(), 1e-6f);
+
+    // Pixels: colour rounded to half, everything else exact.
+    std::vector<float> red(15), depth(15), cost(15);
+    std::vector<std::uint32_t> id(15);
+    Imf::FrameBuffer frame_buffer;
+    frame_buffer.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(red.data()),
+                                        sizeof(float), 5 * sizeof(float)));
+    frame_buffer.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(depth.data()),
+                                        sizeof(float), 5 * sizeof(float)));
+    frame_buffer.insert("cost", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(cost.data()),
+                                           sizeof(float), 5 * sizeof(float)));
+    frame_buffer.insert("id", Imf::Slice(Imf::UINT, reinterpret_cast<char*>(id.data()),
+                                         sizeof(std::uint32_t), 5 * sizeof(std::uint32_t)));
+    file.setFrameBuffer(frame_buffer);
+    file.readPixels(0, 2);
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 5; ++x) {
+            const Pixel& pixel = image.at(x, y);
+            const int i = 5 * y + x;
+            EXPECT_EQ(red[i], float(half(pixel.red)));
+            EXPECT_EQ(depth[i], pixel.depth);
+            EXPECT_EQ(cost[i], pixel.cost);
+            EXPECT_EQ(id[i], pixel.object_id);
+        }
+    }
+    EXPECT_EQ(depth[3], std::numeric_limits<float>::infinity());  // background
+    EXPECT_EQ(id[3], 4294967295u);
+}
+
+TEST(ReadExr, RoundTripsPixelsAndMetadata) {
+    const auto directory = fresh_directory("exr_round_trip");
+    const Image image = sample_image();
+    ExrMetadata metadata = sample_metadata();
+    metadata.camera.projection = Camera::Projection::Orthographic;
+    metadata.camera.orthographic_height = 3.5;
+    write_exr(directory / "out.exr", image, metadata);
+    const ExrFile file = read_exr(directory / "out.exr");
+    ASSERT_EQ(file.image.width(), 5);
+    ASSERT_EQ(file.image.height(), 3);
+    for (std::size_t i = 0; i < image.pixel_count(); ++i) {
+        const Pixel& a = image.pixels()[i];
+        const Pixel& b = file.image.pixels()[i];
+        EXPECT_EQ(b.green, float(half(a.green)));
+        EXPECT_EQ(b.blue, float(half(a.blue)));
+        EXPECT_EQ(b.alpha, float(half(a.alpha)));
+        EXPECT_EQ(b.depth, a.depth);
+        EXPECT_EQ(b.normal_x, a.normal_x);
+        EXPECT_EQ(b.normal_y, a.normal_y);
+        EXPECT_EQ(b.normal_z, a.normal_z);
+        EXPECT_EQ(b.object_id, a.object_id);
+        EXPECT_EQ(b.cost, a.cost);
+    }
+    EXPECT_EQ(file.metadata.camera.projection, Camera::Projection::Orthographic);
+    EXPECT_EQ(file.metadata.camera.orthographic_height, 3.5);
+    EXPECT_EQ(file.metadata.camera.position, Point3(1, 2, 10));
+    EXPECT_EQ(file.metadata.camera.look_at, Point3(1, 2, 0));
+    EXPECT_EQ(file.metadata.accelerator, "brute");
+    EXPECT_EQ(file.metadata.samples_per_pixel, 16);
+}
+
+TEST(WriteExr, LeavesNothingWhenTheDirectoryIsMissing) {
+    const auto directory = fresh_directory("exr_missing");
+    try {
+        write_exr(directory / "no" / "out.exr", sample_image(), sample_metadata());
+        FAIL() << "no exception";
+    } catch (const std::runtime_error& error) {
+        EXPECT_NE(std::string(error.what()).find("out.exr"), std::string::npos) << error.what();
+    }
+    EXPECT_TRUE(names_in(directory).empty());
+}
+
+TEST(WriteExr, ReplacesAnExistingFileWhole) {
+    const auto directory = fresh_directory("exr_replace");
+    {
+        std::ofstream old(directory / "out.exr");
+        old << "old contents";
+    }
+    write_exr(directory / "out.exr", sample_image(), sample_metadata());
+    EXPECT_EQ(read_exr(directory / "out.exr").image.width(), 5);
+    EXPECT_EQ(names_in(directory), std::vector<std::string>{"out.exr"});
+}
+
+TEST(WriteRenderFiles, WritesTheExrAndBothPreviewsBesideIt) {
+    const auto directory = fresh_directory("exr_render_files");
+    write_render_files(directory / "frame.exr", sample_image(), sample_metadata());
+    EXPECT_EQ(names_in(directory),
+              (std::vector<std::string>{"frame.cost.png", "frame.exr", "frame.png"}));
+    EXPECT_EQ(colour_preview_path("a/b/out.exr"), std::filesystem::path("a/b/out.png"));
+    EXPECT_EQ(cost_preview_path("a/b/out.exr"), std::filesystem::path("a/b/out.cost.png"));
+}
+
+TEST(WriteRenderFiles, WritesNoneWhenOneTargetCannotBeWritten) {
+    const auto directory = fresh_directory("exr_render_files_blocked");
+    // A directory where the cost preview should go: that file cannot be created.
+    std::filesystem::create_directory(directory / "frame.cost.png");
+    EXPECT_THROW(write_render_files(directory / "frame.exr", sample_image(), sample_metadata()),
+                 std::runtime_error);
+    EXPECT_EQ(names_in(directory), std::vector<std::string>{"frame.cost.png"});
+    EXPECT_TRUE(std::filesystem::is_directory(directory / "frame.cost.png"));
+}
+
+TEST(ReadExr, ReportsAFileThatIsNotAnExr) {
+    const auto directory = fresh_directory("exr_not_exr");
+    {
+        std::ofstream text(directory / "text.exr");
+        text << "not an image";
+    }
+    EXPECT_THROW(read_exr(directory / "text.exr"), std::runtime_error);
+    EXPECT_THROW(read_exr(directory / "missing.exr"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace csgrt

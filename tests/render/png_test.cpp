@@ -1,0 +1,151 @@
+#include "csgrt/render/png.h"
+
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <vector>
+
+namespace csgrt {
+namespace {
+
+/// A fresh, empty directory under the build tree for one test's files.
+std::filesystem::path fresh_directory(const std::string& name) {
+    const std::filesystem::path path =
+        std::filesystem::path(CSGRT_BINARY_DIR) / "test_output" / name;
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+    return path;
+}
+
+/// An 8-bit RGB PNG read with libpng's simplified API.
+struct Rgb8 {
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> data;
+    std::array<int, 3> at(int x, int y) const {
+        const std::size_t i = 3 * (static_cast<std::size_t>(y) * width + x);
+        return {data[i], data[i + 1], data[i + 2]};
+    }
+};
+
+Rgb8 read_png(const std::filesystem::path& path) {
+    png_image image;
+    std::memset(&image, 0, sizeof(image));
+    image.version = PNG_IMAGE_VERSION;
+    EXPECT_TRUE(png_image_begin_read_from_file(&image, path.c_str())) << image.message;
+    image.format = PNG_FORMAT_RGB;
+    Rgb8 result;
+    result.width = static_cast<int>(image.width);
+    result.height = static_cast<int>(image.height);
+    result.data.resize(PNG_IMAGE_SIZE(image));
+    EXPECT_TRUE(png_image_finish_read(&image, nullptr, result.data.data(), 0, nullptr))
+        << image.message;
+    return result;
+}
+
+TEST(EncodeSrgb8, MatchesTheSrgbTableAndClamps) {
+    // Codes from the IEC 61966-2-1 curve: code 188 is linear 0.5029, code 128 is 0.2159,
+    // the linear segment ends at 0.0031308 (code 10.3).
+    EXPECT_EQ(encode_srgb8(0.0), 0);
+    EXPECT_EQ(encode_srgb8(1.0), 255);
+    EXPECT_EQ(encode_srgb8(0.5029), 188);
+    EXPECT_EQ(encode_srgb8(0.5), 188);
+    EXPECT_EQ(encode_srgb8(0.2159), 128);
+    EXPECT_EQ(encode_srgb8(0.0031308), 10);
+    EXPECT_EQ(encode_srgb8(0.001), 3);  // 12.92 * 0.001 * 255 = 3.29
+    EXPECT_EQ(encode_srgb8(-0.5), 0);
+    EXPECT_EQ(encode_srgb8(7.0), 255);
+    EXPECT_EQ(encode_srgb8(std::numeric_limits<double>::quiet_NaN()), 0);
+    EXPECT_EQ(encode_srgb8(std::numeric_limits<double>::infinity()), 255);
+    // Monotone, and every code is reached.
+    std::array<bool, 256> seen{};
+    int previous = 0;
+    for (int i = 0; i <= 100000; ++i) {
+        const int code = encode_srgb8(i / 100000.0);
+        ASSERT_GE(code, previous);
+        previous = code;
+        seen[code] = true;
+    }
+    for (bool reached : seen) EXPECT_TRUE(reached);
+}
+
+TEST(Viridis, FollowsMatplotlibsTable) {
+    // Entries 0, 64, 128, 192 and 255 of matplotlib's 256-entry viridis table (_cm_listed.py).
+    const std::array<std::pair<double, Vector3>, 5> table = {{
+        {0.0, Vector3(0.267004, 0.004874, 0.329415)},
+        {64.0 / 255.0, Vector3(0.229739, 0.322361, 0.545706)},
+        {128.0 / 255.0, Vector3(0.127568, 0.566949, 0.550556)},
+        {192.0 / 255.0, Vector3(0.369214, 0.788888, 0.382914)},
+        {1.0, Vector3(0.993248, 0.906157, 0.143936)},
+    }};
+    for (const auto& [t, expected] : table) {
+        // The degree-6 fit stays within 0.013 of all 256 entries (measured; 3.3 codes in 8 bits).
+        EXPECT_LT((viridis(t) - expected).cwiseAbs().maxCoeff(), 0.013) << "t = " << t;
+    }
+    EXPECT_EQ(viridis(-3.0), viridis(0.0));
+    EXPECT_EQ(viridis(9.0), viridis(1.0));
+    // Perceptually ordered: luminance-ish (the green channel) rises monotonically.
+    for (int i = 1; i <= 100; ++i) EXPECT_GT(viridis(i / 100.0).y(), viridis((i - 1) / 100.0).y());
+}
+
+TEST(WriteColourPng, StoresEachChannelSrgbEncoded) {
+    const auto directory = fresh_directory("png_colour");
+    Image image(3, 2);
+    image.at(0, 0) = Pixel{.red = 1.0f, .green = 0.5f, .blue = 0.0f, .alpha = 1.0f};
+    image.at(2, 1) = Pixel{.red = 0.2159f, .green = 4.0f, .blue = -1.0f, .alpha = 1.0f};
+    write_colour_png(directory / "c.png", image);
+    const Rgb8 png = read_png(directory / "c.png");
+    EXPECT_EQ(png.width, 3);
+    EXPECT_EQ(png.height, 2);
+    EXPECT_EQ(png.at(0, 0), (std::array<int, 3>{255, 188, 0}));
+    EXPECT_EQ(png.at(2, 1), (std::array<int, 3>{128, 255, 0}));
+    EXPECT_EQ(png.at(1, 0), (std::array<int, 3>{0, 0, 0}));  // background: black
+}
+
+TEST(WriteCostPng, NormalisesByTheLargestCost) {
+    const auto directory = fresh_directory("png_cost");
+    Image image(4, 1);
+    image.at(0, 0).cost = 0.0f;
+    image.at(1, 0).cost = 10.0f;
+    image.at(2, 0).cost = 40.0f;
+    image.at(3, 0).cost = 20.0f;
+    write_cost_png(directory / "cost.png", image);
+    const Rgb8 png = read_png(directory / "cost.png");
+    auto code = [](double t) {
+        const Vector3 c = viridis(t);
+        return std::array<int, 3>{int(std::lround(c.x() * 255)), int(std::lround(c.y() * 255)),
+                                  int(std::lround(c.z() * 255))};
+    };
+    EXPECT_EQ(png.at(0, 0), code(0.0));
+    EXPECT_EQ(png.at(1, 0), code(0.25));
+    EXPECT_EQ(png.at(2, 0), code(1.0));
+    EXPECT_EQ(png.at(3, 0), code(0.5));
+    // Viridis ends: dark blue-violet and yellow, within the fit's 3.3 codes of the table's
+    // values plus the two roundings to a code (4 codes in all).
+    auto near = [](std::array<int, 3> a, std::array<int, 3> b) {
+        for (int i = 0; i < 3; ++i) {
+            if (std::abs(a[i] - b[i]) > 4) return false;
+        }
+        return true;
+    };
+    EXPECT_TRUE(near(png.at(0, 0), {68, 1, 84}));
+    EXPECT_TRUE(near(png.at(2, 0), {253, 231, 37}));
+
+    Image flat(2, 2);  // every cost 0: no division by zero, all the low end
+    write_cost_png(directory / "flat.png", flat);
+    EXPECT_EQ(read_png(directory / "flat.png").at(1, 1), code(0.0));
+}
+
+TEST(WriteColourPng, ReportsAnUnwritablePath) {
+    const auto directory = fresh_directory("png_bad");
+    EXPECT_THROW(write_colour_png(directory / "missing" / "c.png", Image(1, 1)),
+                 std::runtime_error);
+    EXPECT_FALSE(std::filesystem::exists(directory / "missing"));
+}
+
+}  // namespace
+}  // namespace csgrt

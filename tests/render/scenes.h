@@ -1,0 +1,75 @@
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "csgrt/core/shapes.h"
+#include "csgrt/csg/boolean.h"
+#include "csgrt/csg/scene.h"
+
+namespace csgrt::test {
+
+/// Three spheres of different colours on a ground plane (y = 0), lit by a point light and a
+/// directional light: shading, hard shadows and object ids in one small scene.
+inline Scene spheres_on_a_plane() {
+    Scene scene;
+    const auto red = scene.add_material(Material{"red", Vector3(0.8, 0.2, 0.2)});
+    const auto green = scene.add_material(Material{"green", Vector3(0.2, 0.7, 0.3)});
+    const auto blue = scene.add_material(Material{"blue", Vector3(0.2, 0.3, 0.9)});
+    scene.add_object(std::make_shared<Plane>(Point3(0, 0, 0), Normal3(0, 1, 0)), 0, "ground");
+    scene.add_object(std::make_shared<Sphere>(Point3(-1.2, 0.6, 0.0), 0.6), red, "left");
+    scene.add_object(std::make_shared<Sphere>(Point3(0.2, 0.9, -0.6), 0.9), green, "middle");
+    scene.add_object(std::make_shared<Sphere>(Point3(1.4, 0.4, 0.7), 0.4), blue, "right");
+    scene.add_light(PointLight{Point3(-3, 6, 4), Vector3(150, 150, 150)});
+    scene.add_light(DirectionalLight{Vector3(0.4, -1.0, -0.3), Vector3(1.5, 1.4, 1.2)});
+    Camera camera;
+    camera.position = Point3(0.5, 2.5, 6.0);
+    camera.look_at = Point3(0.0, 0.6, 0.0);
+    camera.vertical_fov_degrees = 40.0;
+    scene.set_camera(camera);
+    return scene;
+}
+
+/// CSG: a box with a spherical bite and a cylindrical hole, and a union of two spheres,
+/// seen by an orthographic camera, with one point light.
+inline Scene csg_solids() {
+    Scene scene;
+    const auto orange = scene.add_material(Material{"orange", Vector3(0.9, 0.5, 0.1)});
+    const auto white = scene.add_material(Material{"white", Vector3(0.9, 0.9, 0.9)});
+    auto box = std::make_shared<Box>(Point3(-1, -1, -1), Point3(1, 1, 1));
+    auto bite = std::make_shared<Sphere>(Point3(1, 1, 1), 1.0);
+    auto hole = std::make_shared<Instance>(std::make_shared<Cylinder>(0.4, -2.0, 2.0, true),
+                                           Transform::rotate(Vector3(1, 0, 0), kPi / 2));
+    scene.add_object(make_difference(box, {bite, hole}), orange, "carved box");
+    auto a = std::make_shared<Sphere>(Point3(2.2, 0.0, 0.0), 0.7);
+    auto b = std::make_shared<Sphere>(Point3(2.7, 0.5, 0.2), 0.5);
+    scene.add_object(make_union({a, b}), white, "blob");
+    scene.add_light(PointLight{Point3(3, 5, 6), Vector3(200, 200, 200)});
+    Camera camera;
+    camera.projection = Camera::Projection::Orthographic;
+    camera.position = Point3(2.5, 2.0, 5.0);
+    camera.look_at = Point3(0.9, 0.1, 0.0);
+    camera.orthographic_height = 4.8;
+    scene.set_camera(camera);
+    return scene;
+}
+
+/// An n x n x n lattice of small spheres and no lights (eye light): many objects, so the
+/// structure over them matters.
+inline Scene sphere_lattice(int n) {
+    Scene scene;
+    for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+            for (int k = 0; k < n; ++k) {
+                scene.add_object(std::make_shared<Sphere>(Point3(i, j, k), 0.3));
+            }
+        }
+    }
+    Camera camera;
+    camera.position = Point3(-0.7 * n, 0.4 * n, 2.2 * n);
+    camera.look_at = Point3(0.5 * (n - 1), 0.5 * (n - 1), 0.5 * (n - 1));
+    scene.set_camera(camera);
+    return scene;
+}
+
+}  // namespace csgrt::test
