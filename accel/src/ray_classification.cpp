@@ -53,9 +53,30 @@ float round_down(double value) {
 constexpr int kDirectionU = 3;
 constexpr int kDirectionV = 4;
 
-/// How many candidates ahead a list walk prefetches their boxes: a list is in key order, not
-/// memory order, so each box is a gather.
-constexpr std::uint32_t kPrefetchDistance = 8;
+/// Entries of a cluster-traversal stack: a binary tree of depth D needs D + 1.
+constexpr int kStackSize = detail::kMaxDepth + 2;
+
+/// The slab test of a float cluster box in double, as conservative as Aabb::intersect (Ize,
+/// "Robust BVH Ray Traversal", JCGT 2013): t_far is moved out by 2 gamma(3) |t_far|.
+inline bool hits_box(const BvhNode& box, const Point3& origin, const Vector3& inverse, double t_min,
+                     double t_max) {
+    for (int axis = 0; axis < 3; ++axis) {
+        double t_near = (double(box.lower[axis]) - origin[axis]) * inverse[axis];
+        double t_far = (double(box.upper[axis]) - origin[axis]) * inverse[axis];
+        if (t_near > t_far) std::swap(t_near, t_far);
+        t_far *= t_far >= 0.0 ? 1.0 + 2.0 * gamma(3) : 1.0 - 2.0 * gamma(3);
+        // Written so a NaN slab leaves the interval unchanged.
+        t_min = t_near > t_min ? t_near : t_min;
+        t_max = t_far < t_max ? t_far : t_max;
+    }
+    return !(t_min > t_max);
+}
+
+/// Where a cluster begins along face axis `axis` in the coordinate that grows along the
+/// rays: x_a, or -x_a on a negative face (exact: float boxes, exact negation).
+inline float begin_key(const BvhNode& box, int axis, bool negative) {
+    return negative ? -box.upper[axis] : box.lower[axis];
+}
 
 /// Numbers every build of every RayClassification, so a thread's cached leaf can never be
 /// mistaken for a leaf of another structure, or of a rebuilt one at the same address.
@@ -78,23 +99,24 @@ thread_local LeafCache leaf_cache;
 template <class Set>
 struct RayClassification<Set>::Node {
     /// Two children, published with release once created; null for a leaf. A child's list
-    /// is filtered from this node's list when a ray first reaches it (`ready`).
+    /// is cut from this node's list when a ray first reaches it (`ready`).
     std::atomic<Node*> children{nullptr};
-    /// The candidates, sorted by key; owned unless `borrowed` (then the parent's list).
+    /// The candidates, sorted by key; owned unless `borrowed` (then the parent's list). Never
+    /// freed before the structure: a ray may still search a list while its cell is split.
     const Candidate* candidates = nullptr;
     std::uint32_t count = 0;
+    /// Primitives under the candidates.
+    std::uint32_t covered = 0;
+    /// Rays that found this leaf too long but not yet visited often enough to split.
+    std::atomic<std::uint32_t> visits{0};
     /// The axis (x, y, z, u, v) the cell was halved along; written before `children`.
     std::uint8_t axis = 0;
-    /// Set with release once `candidates` and `count` are final.
+    /// Set with release once `candidates`, `count` and `covered` are final.
     std::atomic<bool> ready{false};
     /// Set when a split was refused (memory cap): the leaf is final.
     std::atomic<bool> closed{false};
     /// The list is the parent's, shared because the memory cap refused a copy.
     bool borrowed = false;
-    /// Under this node's lock: how many children have their lists, and whether one borrows
-    /// this node's list (which must then live on).
-    std::uint8_t ready_children = 0;
-    bool lent = false;
 
     ~Node() {
         if (!borrowed) delete[] candidates;
@@ -117,6 +139,10 @@ void RayClassification<Set>::build(const Set& set, const RayClassificationConfig
             config.max_depth);
     require(config.build_depth >= 0 && config.build_depth <= 60, what, "build_depth", "in [0, 60]",
             config.build_depth);
+    require(config.visits_before_split >= 1, what, "visits_before_split", ">= 1",
+            config.visits_before_split);
+    require(config.cluster_width > 0.0 && std::isfinite(config.cluster_width), what,
+            "cluster_width", "finite and > 0", config.cluster_width);
     const auto start = std::chrono::steady_clock::now();
     set_ = &set;
     config_ = config;
@@ -135,23 +161,25 @@ void RayClassification<Set>::build(const Set& set, const RayClassificationConfig
         config_.max_depth = static_cast<int>(std::clamp(depth, 12.0, 60.0));
     }
     std::vector<Aabb> boxes(count);
-    boxes_.clear();
+    clusters_.clear();
+    cluster_primitives_.clear();
+    cluster_sizes_.clear();
+    bounded_.clear();
     unbounded_.clear();
-    std::vector<std::uint32_t> bounded;
     Aabb bounds;
     for (std::size_t i = 0; i < count; ++i) {
         const Aabb box = set.bounds(i);
         if (box.is_finite() && !box.is_empty()) {
             boxes[i] = box;
             bounds.extend(box);
-            bounded.push_back(static_cast<std::uint32_t>(i));
+            bounded_.push_back(static_cast<std::uint32_t>(i));
         } else {
             unbounded_.push_back(static_cast<std::uint32_t>(i));
         }
     }
     largest_coordinate_ = 0.0;
     padding_ = 0.0;
-    if (!bounded.empty()) {
+    if (!bounded_.empty()) {
         const double largest =
             std::max(bounds.lower.cwiseAbs().maxCoeff(), bounds.upper.cwiseAbs().maxCoeff());
         const double diagonal = bounds.diagonal().norm();
@@ -165,46 +193,52 @@ void RayClassification<Set>::build(const Set& set, const RayClassificationConfig
         if (!(largest + diagonal + 4.0 * padding_ < 1e37)) {
             // Coordinates near the float range leave no room for padded float boxes and keys:
             // every ray tests everything.
-            unbounded_.insert(unbounded_.end(), bounded.begin(), bounded.end());
+            unbounded_.insert(unbounded_.end(), bounded_.begin(), bounded_.end());
             std::sort(unbounded_.begin(), unbounded_.end());
-            bounded.clear();
+            bounded_.clear();
         }
     }
-    if (!bounded.empty()) {
+    if (!bounded_.empty()) {
         const Vector3 pad = Vector3::Constant(padding_);
-        boxes_.assign(count, PaddedBox{});
-        for (std::uint32_t i : bounded) {
-            boxes[i].lower -= pad;
-            boxes[i].upper += pad;
-            for (int k = 0; k < 3; ++k) {
-                boxes_[i].lower[k] = round_down(boxes[i].lower[k]);
-                boxes_[i].upper[k] = -round_down(-boxes[i].upper[k]);
+        std::vector<detail::BuildPrimitive> primitives(bounded_.size());
+        for (std::size_t k = 0; k < bounded_.size(); ++k) {
+            const Aabb& box = boxes[bounded_[k]];
+            for (int axis = 0; axis < 3; ++axis) {
+                primitives[k].lower[axis] = round_down(box.lower[axis] - pad[axis]);
+                primitives[k].upper[axis] = -round_down(-(box.upper[axis] + pad[axis]));
             }
+            primitives[k].index = bounded_[k];
         }
+        // Clusters: a binned-SAH hierarchy over the padded boxes (its node boxes are unions of
+        // float boxes, so they hold every padded box exactly).
+        BvhConfig cluster_config;
+        cluster_config.max_leaf_size = 2;
+        cluster_config.width = 2;
+        cluster_config.parallel = false;
+        detail::BinaryBvh tree = detail::build_binary_bvh(primitives, cluster_config);
+        clusters_ = std::move(tree.nodes);
+        cluster_primitives_ = std::move(tree.indices);
+        cluster_sizes_.assign(clusters_.size(), 0);
+        auto size_of = [&](auto&& self, std::uint32_t id) -> std::uint32_t {
+            const BvhNode& node = clusters_[id];
+            cluster_sizes_[id] =
+                node.is_leaf() ? node.count : self(self, node.offset) + self(self, node.offset + 1);
+            return cluster_sizes_[id];
+        };
+        size_of(size_of, 0);
         scene_ = Aabb(bounds.lower - 2.0 * pad, bounds.upper + 2.0 * pad);
         roots_ = std::make_unique<Node[]>(6);
         for (int face = 0; face < 6; ++face) {
             Node& root = roots_[face];
-            const int axis = face / 2;
-            const bool negative = face % 2 == 1;
-            root.count = static_cast<std::uint32_t>(bounded.size());
-            Candidate* list = new Candidate[bounded.size()];
-            root.candidates = list;
-            for (std::size_t k = 0; k < bounded.size(); ++k) {
-                const Aabb& box = boxes[bounded[k]];
-                // The coordinate that grows along the face's rays: x_a, or -x_a on a negative
-                // face; a box begins where that coordinate is smallest.
-                const double begin = negative ? -box.upper[axis] : box.lower[axis];
-                list[k] = Candidate{round_down(begin), bounded[k]};
-            }
-            std::sort(list, list + root.count, [](const Candidate& x, const Candidate& y) {
-                return x.key < y.key || (x.key == y.key && x.index < y.index);
-            });
+            root.candidates =
+                new Candidate[1]{{begin_key(clusters_[0], face / 2, face % 2 == 1), 0}};
+            root.count = 1;
+            root.covered = cluster_sizes_[0];
             root.ready.store(true, std::memory_order_relaxed);
         }
         nodes_ = 6;
-        references_ = 6 * bounded.size();
-        candidate_bytes_ = 6 * bounded.size() * sizeof(Candidate);
+        references_ = 6;
+        candidate_bytes_ = 6 * (sizeof(Node) + sizeof(Candidate));
         for (int face = 0; face < 6 && config.build_depth > 0; ++face) {
             double lower[5], upper[5];
             root_cell(lower, upper);
@@ -226,11 +260,15 @@ void RayClassification<Set>::root_cell(double lower[5], double upper[5]) const {
 }
 
 template <class Set>
+bool RayClassification<Set>::is_final(const Node& node, int depth) const {
+    return node.covered <= config_.max_leaf_candidates || depth >= config_.max_depth ||
+           node.closed.load(std::memory_order_relaxed);
+}
+
+template <class Set>
 void RayClassification<Set>::subdivide(Node& node, int face, int depth, double lower[5],
                                        double upper[5]) {
-    if (node.count <= config_.max_leaf_candidates || depth >= config_.max_depth ||
-        depth >= config_.build_depth)
-        return;
+    if (is_final(node, depth) || depth >= config_.build_depth) return;
     split(node, face, depth, lower, upper);
     Node* children = node.children.load(std::memory_order_acquire);
     if (children == nullptr) return;
@@ -241,15 +279,14 @@ void RayClassification<Set>::subdivide(Node& node, int face, int depth, double l
         std::copy(lower, lower + 5, child_lower);
         std::copy(upper, upper + 5, child_upper);
         (side == 0 ? child_upper : child_lower)[axis] = middle;
-        materialize(node, children[side], face, depth + 1, child_lower, child_upper);
+        materialize(node, children[side], face, child_lower, child_upper);
         subdivide(children[side], face, depth + 1, child_lower, child_upper);
     }
 }
 
 template <class Set>
-int RayClassification<Set>::split_axis(int face, int depth, const double lower[5],
-                                       const double upper[5]) const {
-    if (config_.split == RayClassificationSplit::kCycle) return depth % 5;
+void RayClassification<Set>::beam_widths(int face, const double lower[5], const double upper[5],
+                                         double& width_b, double& width_c) const {
     const int a = face / 2, b = (a + 1) % 3, c = (a + 2) % 3;
     const bool negative = face % 2 == 1;
     // The beam's width across the rays, along b and c: the origin extent, plus the origin
@@ -259,20 +296,34 @@ int RayClassification<Set>::split_axis(int face, int depth, const double lower[5
     const double extent_a = upper[a] - lower[a];
     const double slope_u = std::max(std::abs(lower[kDirectionU]), std::abs(upper[kDirectionU]));
     const double slope_v = std::max(std::abs(lower[kDirectionV]), std::abs(upper[kDirectionV]));
-    const double fan_u = (upper[kDirectionU] - lower[kDirectionU]) * reach;
-    const double fan_v = (upper[kDirectionV] - lower[kDirectionV]) * reach;
-    const double width_b = upper[b] - lower[b] + extent_a * slope_u + fan_u;
-    const double width_c = upper[c] - lower[c] + extent_a * slope_v + fan_v;
-    // Halving an axis removes half its term; pick the axis that shrinks the beam's cross
-    // section (width_b * width_c) by the largest factor.
+    width_b = upper[b] - lower[b] + extent_a * slope_u +
+              (upper[kDirectionU] - lower[kDirectionU]) * reach;
+    width_c = upper[c] - lower[c] + extent_a * slope_v +
+              (upper[kDirectionV] - lower[kDirectionV]) * reach;
+}
+
+template <class Set>
+int RayClassification<Set>::split_axis(int face, int depth, const double lower[5],
+                                       const double upper[5]) const {
+    if (config_.split == RayClassificationSplit::kCycle) return depth % 5;
+    const int a = face / 2, b = (a + 1) % 3, c = (a + 2) % 3;
+    const bool negative = face % 2 == 1;
+    double width_b, width_c;
+    beam_widths(face, lower, upper, width_b, width_c);
+    const double reach = negative ? upper[a] - scene_.lower[a] : scene_.upper[a] - lower[a];
+    const double extent_a = upper[a] - lower[a];
+    const double slope_u = std::max(std::abs(lower[kDirectionU]), std::abs(upper[kDirectionU]));
+    const double slope_v = std::max(std::abs(lower[kDirectionV]), std::abs(upper[kDirectionV]));
+    // Halving an axis removes half its term of the widths; pick the axis that shrinks the
+    // beam's cross section (width_b * width_c) by the largest factor.
     const double inverse_b = width_b > 0.0 ? 1.0 / width_b : 0.0;
     const double inverse_c = width_c > 0.0 ? 1.0 / width_c : 0.0;
     double gains[5];
     gains[a] = extent_a * (slope_u * inverse_b + slope_v * inverse_c);
     gains[b] = (upper[b] - lower[b]) * inverse_b;
     gains[c] = (upper[c] - lower[c]) * inverse_c;
-    gains[kDirectionU] = fan_u * inverse_b;
-    gains[kDirectionV] = fan_v * inverse_c;
+    gains[kDirectionU] = (upper[kDirectionU] - lower[kDirectionU]) * reach * inverse_b;
+    gains[kDirectionV] = (upper[kDirectionV] - lower[kDirectionV]) * reach * inverse_c;
     return static_cast<int>(std::max_element(gains, gains + 5) - gains);
 }
 
@@ -289,7 +340,10 @@ void RayClassification<Set>::split(Node& node, int face, int depth, const double
     if (node.children.load(std::memory_order_relaxed) != nullptr ||
         node.closed.load(std::memory_order_relaxed))
         return;
-    if (candidate_bytes_.load(std::memory_order_relaxed) >= config_.max_candidate_bytes) {
+    const std::size_t bytes = 2 * sizeof(Node);
+    if (candidate_bytes_.fetch_add(bytes, std::memory_order_relaxed) + bytes >
+        config_.max_candidate_bytes) {
+        candidate_bytes_.fetch_sub(bytes, std::memory_order_relaxed);
         node.closed.store(true, std::memory_order_relaxed);
         splits_refused_.fetch_add(1, std::memory_order_relaxed);
         return;
@@ -305,10 +359,10 @@ void RayClassification<Set>::split(Node& node, int face, int depth, const double
 }
 
 template <class Set>
-void RayClassification<Set>::materialize(Node& parent, Node& child, int face, int depth,
+void RayClassification<Set>::materialize(const Node& parent, Node& child, int face,
                                          const double lower[5], const double upper[5]) const {
     const auto start = std::chrono::steady_clock::now();
-    // The parent's lock: both children read the parent's list, and the second frees it.
+    // The parent's lock: both children are cut from the parent's list.
     std::lock_guard<std::mutex> lock(lock_of(parent));
     if (child.ready.load(std::memory_order_relaxed)) return;
     detail::RayCell cell;
@@ -321,17 +375,47 @@ void RayClassification<Set>::materialize(Node& parent, Node& child, int face, in
     cell.v_lower = lower[kDirectionV];
     cell.v_upper = upper[kDirectionV];
     const detail::Beam beam(cell);
-    // A child filters its parent's list, never the whole scene; keeping its order keeps it
-    // sorted. Reused per thread, so only what is kept is allocated.
+    const int a = cell.axis, b = (a + 1) % 3, c = (a + 2) % 3;
+    double width_b, width_c;
+    beam_widths(face, lower, upper, width_b, width_c);
+    const double limit_b = config_.cluster_width * width_b;
+    const double limit_c = config_.cluster_width * width_c;
+    auto meets = [&](std::uint32_t id) {
+        return beam.may_hit(clusters_[id].lower, clusters_[id].upper);
+    };
+    // A child's list is cut from its parent's, never from the whole scene: each cluster the
+    // beam meets is kept, or replaced by its halves while it is wider than the beam (or when
+    // the beam meets only one of them). Reused per thread, so only what is kept is allocated.
     static thread_local std::vector<Candidate> kept;
+    static thread_local std::vector<std::uint32_t> pending;
     kept.clear();
-    for (std::uint32_t k = 0; k < parent.count; ++k) {
-        if (k + kPrefetchDistance < parent.count)
-            __builtin_prefetch(&boxes_[parent.candidates[k + kPrefetchDistance].index]);
-        const Candidate candidate = parent.candidates[k];
-        const PaddedBox& box = boxes_[candidate.index];
-        if (beam.may_hit(box.lower, box.upper)) kept.push_back(candidate);
+    pending.clear();
+    for (std::uint32_t k = 0; k < parent.count; ++k)
+        pending.push_back(parent.candidates[k].cluster);
+    std::uint32_t covered = 0;
+    while (!pending.empty()) {
+        const std::uint32_t id = pending.back();
+        pending.pop_back();
+        const BvhNode& node = clusters_[id];
+        if (!meets(id)) continue;
+        if (!node.is_leaf()) {
+            const bool wide = double(node.upper[b]) - double(node.lower[b]) > limit_b ||
+                              double(node.upper[c]) - double(node.lower[c]) > limit_c;
+            const bool first = wide || meets(node.offset);
+            const bool second = wide || meets(node.offset + 1);
+            if (wide || first != second) {
+                if (first) pending.push_back(node.offset);
+                if (second) pending.push_back(node.offset + 1);
+                continue;
+            }
+            if (!first) continue;
+        }
+        kept.push_back(Candidate{begin_key(node, a, cell.negative), id});
+        covered += cluster_sizes_[id];
     }
+    std::sort(kept.begin(), kept.end(), [](const Candidate& x, const Candidate& y) {
+        return x.key < y.key || (x.key == y.key && x.cluster < y.cluster);
+    });
     const std::size_t bytes = kept.size() * sizeof(Candidate);
     const std::size_t before = candidate_bytes_.fetch_add(bytes, std::memory_order_relaxed);
     if (before + bytes > config_.max_candidate_bytes) {
@@ -340,27 +424,19 @@ void RayClassification<Set>::materialize(Node& parent, Node& child, int face, in
         splits_refused_.fetch_add(1, std::memory_order_relaxed);
         child.candidates = parent.candidates;
         child.count = parent.count;
+        child.covered = parent.covered;
         child.borrowed = true;
         child.closed.store(true, std::memory_order_relaxed);
-        parent.lent = true;
     } else {
         Candidate* list = new Candidate[kept.size()];
         std::copy(kept.begin(), kept.end(), list);
         child.candidates = list;
         child.count = static_cast<std::uint32_t>(kept.size());
+        child.covered = covered;
         references_.fetch_add(kept.size(), std::memory_order_relaxed);
     }
     // Release: a reader that sees `ready` sees the list.
     child.ready.store(true, std::memory_order_release);
-    // Once both children have their lists nothing reads the parent's (only final leaves are
-    // searched), unless a child borrows it. Root lists stay: rays too far away for the
-    // padding search them whole.
-    if (++parent.ready_children == 2 && !parent.lent && depth > 1) {
-        candidate_bytes_.fetch_sub(parent.count * sizeof(Candidate), std::memory_order_relaxed);
-        references_.fetch_sub(parent.count, std::memory_order_relaxed);
-        delete[] parent.candidates;
-        parent.candidates = nullptr;
-    }
     lazy_nanoseconds_.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                     std::chrono::steady_clock::now() - start)
                                     .count(),
@@ -369,26 +445,36 @@ void RayClassification<Set>::materialize(Node& parent, Node& child, int face, in
 
 template <class Set>
 const typename RayClassification<Set>::Node* RayClassification<Set>::locate(
-    int face, const double coordinates[5], TraversalCounters& counters, double lower[5],
-    double upper[5]) const {
+    int face, const double coordinates[5], bool eager, TraversalCounters& counters, double lower[5],
+    double upper[5], bool& final_leaf) const {
     Node* node = &roots_[face];
     root_cell(lower, upper);
+    final_leaf = false;
     for (int depth = 0;; ++depth) {
         ++counters.nodes_visited;
         // Acquire pairs with the releases in split() and materialize(): once built, a path
         // costs no lock.
         Node* children = node->children.load(std::memory_order_acquire);
         if (children == nullptr) {
-            if (node->count <= config_.max_leaf_candidates || depth >= config_.max_depth ||
-                node->closed.load(std::memory_order_relaxed))
+            if (is_final(*node, depth)) {
+                final_leaf = true;
+                return node;
+            }
+            // A cell is refined only for rays that come back: a cell that one incoherent ray
+            // reaches is cheaper searched than cut.
+            if (!eager && node->visits.fetch_add(1, std::memory_order_relaxed) + 1 <
+                              config_.visits_before_split)
                 return node;
             split(*node, face, depth, lower, upper);
             children = node->children.load(std::memory_order_acquire);
-            if (children == nullptr) return node;  // the memory cap refused the split
+            if (children == nullptr) {  // the memory cap refused the split
+                final_leaf = true;
+                return node;
+            }
         }
         const int axis = node->axis;
         const double middle = 0.5 * lower[axis] + 0.5 * upper[axis];
-        Node* parent = node;
+        const Node* parent = node;
         if (coordinates[axis] < middle) {
             upper[axis] = middle;
             node = &children[0];
@@ -397,13 +483,13 @@ const typename RayClassification<Set>::Node* RayClassification<Set>::locate(
             node = &children[1];
         }
         if (!node->ready.load(std::memory_order_acquire))
-            materialize(*parent, *node, face, depth + 1, lower, upper);
+            materialize(*parent, *node, face, lower, upper);
     }
 }
 
 template <class Set>
 typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
-    const Ray& ray, TraversalCounters& counters) const {
+    const Ray& ray, TraversalCounters& counters, bool eager) const {
     Search search;
     if (!roots_) return search;
     const detail::DirectionFace direction = detail::direction_face(ray.direction);
@@ -411,9 +497,8 @@ typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
     const double origin_size = ray.origin.cwiseAbs().maxCoeff();
     if (hit_error_ * (origin_size + largest_coordinate_) > 0.5 * padding_) {
         // The set's own rounding for a ray from this far may exceed the padding: test every
-        // bounded primitive, in no particular order.
-        search.candidates = roots_[face].candidates;
-        search.count = roots_[face].count;
+        // bounded primitive, without box tests.
+        search.far = true;
         return search;
     }
     ++counters.boxes_tested;
@@ -435,15 +520,19 @@ typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
         leaf = static_cast<const Node*>(cache.leaf);
         ++counters.nodes_visited;
     } else {
-        cache.build_id = 0;  // invalid until locate() has written the new cell
-        leaf = locate(face, coordinates, counters, cache.lower, cache.upper);
-        cache.build_id = build_id_;
-        cache.face = face;
-        cache.leaf = leaf;
+        cache.build_id = 0;  // invalid until locate() has written a final leaf's cell
+        bool final_leaf = false;
+        leaf = locate(face, coordinates, eager, counters, cache.lower, cache.upper, final_leaf);
+        if (final_leaf) {
+            cache.build_id = build_id_;
+            cache.face = face;
+            cache.leaf = leaf;
+        }
     }
     search.candidates = leaf->candidates;
     search.count = leaf->count;
-    search.stops_early = true;
+    search.axis = direction.axis;
+    search.negative = direction.negative;
     const double sign = direction.negative ? -1.0 : 1.0;
     search.w_origin = sign * ray.origin[direction.axis];
     search.w_speed = std::abs(ray.direction[direction.axis]);
@@ -451,11 +540,6 @@ typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
 }
 
 namespace {
-/// Lists longer than this (cells that the memory cap or max_depth left long) test each
-/// candidate's padded box before the primitive: a slab test is cheaper than most primitive
-/// tests, and in a long list most candidates are far from the ray.
-constexpr std::uint32_t kBoxTestedLength = 64;
-
 /// An upper bound on the face-axis coordinate w_origin + t w_speed of the ray at t, rounded
 /// up by the error of its two operations (NaN for t = -inf, which never stops a search).
 inline double stop_position(double w_origin, double w_speed, double t) {
@@ -502,37 +586,45 @@ bool RayClassification<Set>::intersect_impl(const Ray& ray, HitRecord& record,
     HitRecord best;
     best.t = ray.t_max;
     bool found = false;
-    std::uint32_t tested = 0;
-    double stop =
-        search.stops_early ? stop_position(search.w_origin, search.w_speed, best.t) : kInfinity;
-    // Far rays (no early stop) may hit outside the padded boxes: never box-test them.
-    const bool box_tested = search.stops_early && search.count > kBoxTestedLength;
+    std::size_t tested = 0, boxes = 0;
+    if (search.far) {
+        for (std::uint32_t index : bounded_) found |= set_->intersect(index, prepared, best);
+        tested += bounded_.size();
+    }
+    double stop = stop_position(search.w_origin, search.w_speed, best.t);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    Ray bounded = ray;
+    std::uint32_t stack[kStackSize];
     for (std::uint32_t k = 0; k < search.count; ++k) {
         const Candidate candidate = search.candidates[k];
         // Sorted by where they begin along the face axis: nothing further can beat `best`.
         if (candidate.key > stop) break;
-        if (box_tested) {
-            if constexpr (kCount) ++counters.boxes_tested;
-            if (k + kPrefetchDistance < search.count)
-                __builtin_prefetch(&boxes_[search.candidates[k + kPrefetchDistance].index]);
-            bounded.t_max = best.t;
-            double t_enter, t_exit;
-            if (!boxes_[candidate.index].to_aabb().intersect(bounded, inverse_direction, t_enter,
-                                                             t_exit))
+        int top = 0;
+        stack[top++] = candidate.cluster;
+        while (top > 0) {
+            const BvhNode& node = clusters_[stack[--top]];
+            ++boxes;
+            if (!hits_box(node, ray.origin, inverse_direction, ray.t_min, best.t)) continue;
+            if (node.is_leaf()) {
+                for (std::uint32_t j = node.offset; j < node.offset + node.count; ++j) {
+                    ++tested;
+                    if (set_->intersect(cluster_primitives_[j], prepared, best)) {
+                        found = true;
+                        stop = stop_position(search.w_origin, search.w_speed, best.t);
+                    }
+                }
                 continue;
-        }
-        ++tested;
-        if (set_->intersect(candidate.index, prepared, best)) {
-            found = true;
-            if (search.stops_early) stop = stop_position(search.w_origin, search.w_speed, best.t);
+            }
+            // The half that begins first along the rays is searched first.
+            const bool swap = begin_key(clusters_[node.offset], search.axis, search.negative) >
+                              begin_key(clusters_[node.offset + 1], search.axis, search.negative);
+            stack[top++] = node.offset + (swap ? 0 : 1);
+            stack[top++] = node.offset + (swap ? 1 : 0);
         }
     }
     for (std::uint32_t index : unbounded_) found |= set_->intersect(index, prepared, best);
     if constexpr (kCount) {
         counters.nodes_visited += local.nodes_visited;
-        counters.boxes_tested += local.boxes_tested;
+        counters.boxes_tested += local.boxes_tested + boxes;
         counters.primitives_tested += tested + unbounded_.size();
     }
     if (found) record = best;
@@ -551,25 +643,34 @@ bool RayClassification<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch
         counters.boxes_tested += local.boxes_tested;
     }
     const auto prepared = set_->prepare(ray, scratch);
-    const double stop =
-        search.stops_early ? stop_position(search.w_origin, search.w_speed, ray.t_max) : kInfinity;
-    // Far rays (no early stop) may hit outside the padded boxes: never box-test them.
-    const bool box_tested = search.stops_early && search.count > kBoxTestedLength;
+    if (search.far) {
+        for (std::uint32_t index : bounded_) {
+            if constexpr (kCount) ++counters.primitives_tested;
+            if (set_->occluded(index, prepared)) return true;
+        }
+    }
+    const double stop = stop_position(search.w_origin, search.w_speed, ray.t_max);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    std::uint32_t stack[kStackSize];
     for (std::uint32_t k = 0; k < search.count; ++k) {
         const Candidate candidate = search.candidates[k];
         if (candidate.key > stop) break;
-        if (box_tested) {
+        int top = 0;
+        stack[top++] = candidate.cluster;
+        while (top > 0) {
+            const BvhNode& node = clusters_[stack[--top]];
             if constexpr (kCount) ++counters.boxes_tested;
-            if (k + kPrefetchDistance < search.count)
-                __builtin_prefetch(&boxes_[search.candidates[k + kPrefetchDistance].index]);
-            double t_enter, t_exit;
-            if (!boxes_[candidate.index].to_aabb().intersect(ray, inverse_direction, t_enter,
-                                                             t_exit))
+            if (!hits_box(node, ray.origin, inverse_direction, ray.t_min, ray.t_max)) continue;
+            if (node.is_leaf()) {
+                for (std::uint32_t j = node.offset; j < node.offset + node.count; ++j) {
+                    if constexpr (kCount) ++counters.primitives_tested;
+                    if (set_->occluded(cluster_primitives_[j], prepared)) return true;
+                }
                 continue;
+            }
+            stack[top++] = node.offset;
+            stack[top++] = node.offset + 1;
         }
-        if constexpr (kCount) ++counters.primitives_tested;
-        if (set_->occluded(candidate.index, prepared)) return true;
     }
     for (std::uint32_t index : unbounded_) {
         if constexpr (kCount) ++counters.primitives_tested;
@@ -585,23 +686,31 @@ void RayClassification<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hi
     TraversalCounters unused;
     const Search search = find_candidates(ray, unused);
     const auto prepared = set_->prepare(ray, scratch);
-    const double stop =
-        search.stops_early ? stop_position(search.w_origin, search.w_speed, ray.t_max) : kInfinity;
     auto collect = [&](std::uint32_t index) {
         HitRecord hit;
         hit.t = ray.t_max;
         if (set_->intersect(index, prepared, hit)) hits.push_back(hit);
     };
-    // Far rays (no early stop) may hit outside the padded boxes: never box-test them.
-    const bool box_tested = search.stops_early && search.count > kBoxTestedLength;
+    if (search.far)
+        for (std::uint32_t index : bounded_) collect(index);
+    const double stop = stop_position(search.w_origin, search.w_speed, ray.t_max);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    // A cell's list holds each primitive once, so each is reported at most once.
+    std::uint32_t stack[kStackSize];
+    // A cell's clusters are disjoint subtrees, so each primitive is reported at most once.
     for (std::uint32_t k = 0; k < search.count && !(search.candidates[k].key > stop); ++k) {
-        const std::uint32_t index = search.candidates[k].index;
-        double t_enter, t_exit;
-        if (!box_tested ||
-            boxes_[index].to_aabb().intersect(ray, inverse_direction, t_enter, t_exit))
-            collect(index);
+        int top = 0;
+        stack[top++] = search.candidates[k].cluster;
+        while (top > 0) {
+            const BvhNode& node = clusters_[stack[--top]];
+            if (!hits_box(node, ray.origin, inverse_direction, ray.t_min, ray.t_max)) continue;
+            if (node.is_leaf()) {
+                for (std::uint32_t j = node.offset; j < node.offset + node.count; ++j)
+                    collect(cluster_primitives_[j]);
+                continue;
+            }
+            stack[top++] = node.offset;
+            stack[top++] = node.offset + 1;
+        }
     }
     for (std::uint32_t index : unbounded_) collect(index);
 }
@@ -610,7 +719,7 @@ template <class Set>
 void RayClassification<Set>::prebuild(std::span<const Ray> rays) {
     TraversalCounters unused;
     for (const Ray& ray : rays)
-        if (set_ != nullptr && is_valid(ray)) find_candidates(ray, unused);
+        if (set_ != nullptr && is_valid(ray)) find_candidates(ray, unused, true);
 }
 
 template <class Set>
@@ -620,8 +729,10 @@ AcceleratorStats RayClassification<Set>::stats() const {
     stats.build_milliseconds = build_milliseconds_;
     const std::size_t nodes = nodes_.load(std::memory_order_relaxed);
     const std::size_t candidate_bytes = candidate_bytes_.load(std::memory_order_relaxed);
-    stats.bytes = boxes_.capacity() * sizeof(PaddedBox) +
-                  unbounded_.capacity() * sizeof(std::uint32_t) + nodes * sizeof(Node) +
+    stats.bytes = clusters_.capacity() * sizeof(BvhNode) +
+                  (cluster_primitives_.capacity() + cluster_sizes_.capacity() +
+                   bounded_.capacity() + unbounded_.capacity()) *
+                      sizeof(std::uint32_t) +
                   candidate_bytes;
     stats.nodes = nodes;
     stats.references = references_.load(std::memory_order_relaxed);
@@ -629,13 +740,15 @@ AcceleratorStats RayClassification<Set>::stats() const {
     const std::size_t refused = splits_refused_.load(std::memory_order_relaxed);
     const std::string cap_note =
         refused > 0 ? ", cap reached: " + std::to_string(refused) + " splits refused" : "";
-    char details[320];
+    char details[400];
     std::snprintf(
         details, sizeof details,
-        "leaf <= %u, max depth %d (deepest %d), split %s, lazy splits %.1f ms, "
-        "candidate lists %.1f MiB of cap %.1f MiB%s, padding %.3g, unbounded %zu",
+        "leaf <= %u primitives, max depth %d (deepest %d), split %s after %u visits, "
+        "%zu clusters (width %.2g), lazy splits %.1f ms, lists and cells %.1f MiB of cap "
+        "%.1f MiB%s, padding %.3g, unbounded %zu",
         config_.max_leaf_candidates, config_.max_depth, deepest_.load(std::memory_order_relaxed),
         config_.split == RayClassificationSplit::kCycle ? "cycle" : "narrow-beam",
+        config_.visits_before_split, clusters_.size(), config_.cluster_width,
         lazy_nanoseconds_.load(std::memory_order_relaxed) * 1e-6, candidate_bytes / 1048576.0,
         config_.max_candidate_bytes / 1048576.0, cap_note.c_str(), padding_, unbounded_.size());
     stats.details = details;

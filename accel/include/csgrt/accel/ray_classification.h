@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/bvh_build.h"
 #include "csgrt/core/aabb.h"
 
 namespace csgrt {
@@ -28,19 +29,25 @@ enum class RayClassificationSplit {
 };
 
 struct RayClassificationConfig {
-    /// A leaf that a ray reaches is split while it holds more candidates than this.
+    /// A leaf that a ray reaches is split while its candidates hold more primitives than this.
     std::uint32_t max_leaf_candidates = 16;
     /// The deepest a face's tree may grow (halvings from its root), at most 60; 0 chooses
     /// round(2.4 log2 n) for n primitives (38 for 50k), about where a cell's beam narrows to
     /// the size of one primitive of an evenly tessellated surface.
     int max_depth = 0;
-    /// Cap on the bytes of all candidate lists, the six root lists included. Once it is
+    /// Cap on the bytes of all candidate lists and cells, the six roots included. Once it is
     /// reached cells stop splitting, and a new cell whose list would not fit searches its
-    /// parent's (longer) list; stats() reports how often either happened. Answers stay exact
-    /// whatever the cap (0: the six sorted root lists only).
+    /// parent's list; stats() reports how often either happened. Answers stay exact whatever
+    /// the cap (0: the six root cells only).
     std::size_t max_candidate_bytes = std::size_t{256} << 20;
     RayClassificationSplit split = RayClassificationSplit::kNarrowBeam;
-    /// Subdivide every cell with more than max_leaf_candidates candidates down to this depth
+    /// A leaf is split only once this many queries have searched it, so a cell that few
+    /// incoherent rays reach is searched, not refined for nobody (>= 1; 1: at the first).
+    std::uint32_t visits_before_split = 16;
+    /// A candidate cluster is replaced by its two halves while it is wider across the rays
+    /// than this many times the cell's beam (> 0): smaller values give longer, tighter lists.
+    double cluster_width = 1.0;
+    /// Subdivide every cell with more than max_leaf_candidates primitives down to this depth
     /// during build(), before any ray arrives (0: purely lazy).
     int build_depth = 0;
 };
@@ -134,9 +141,11 @@ inline bool beam_may_hit(const RayCell& cell, const Aabb& box) {
 /// a ray is a point of 5D ray space (where it enters the scene box, and its direction as a
 /// point of one face of the direction cube), six binary trees of hypercubes cover that space,
 /// and each hypercube keeps the candidates its beam can meet, sorted by where they begin along
-/// the face's axis so a search stops at the first candidate beyond the best hit. Hypercubes
-/// are split lazily, when rays reach them; lazy splitting is thread-safe, and once a path is
-/// built queries take no lock (docs/structures.md).
+/// the face's axis so a search stops at the first candidate beyond the best hit. Candidates
+/// are clusters of primitives (nodes of a bounding-volume hierarchy), cut finer as the beams
+/// narrow, so a wide beam lists a few large clusters rather than thousands of primitives.
+/// Hypercubes are split lazily, when rays reach them; lazy splitting is thread-safe, and once
+/// a path is built queries take no lock (docs/structures.md).
 template <class Set>
 class RayClassification final : public Accelerator<Set> {
 public:
@@ -145,11 +154,12 @@ public:
     RayClassification(const RayClassification&) = delete;
     RayClassification& operator=(const RayClassification&) = delete;
 
-    /// Pads and sorts the primitives into the six root cells, then subdivides to
-    /// config.build_depth. Throws InvalidParameter for a bad configuration.
+    /// Pads the primitives' boxes, clusters them, makes the six root cells, then subdivides
+    /// to config.build_depth. Throws InvalidParameter for a bad configuration.
     void build(const Set& set, const RayClassificationConfig& config = {});
-    /// Classifies `rays` as queries would, splitting every cell they reach, so a benchmark
-    /// can time the lazy build apart from the queries. Safe alongside queries.
+    /// Classifies `rays` as queries would, splitting every cell they reach that is too long
+    /// (without waiting for config.visits_before_split visits), so a benchmark can time the
+    /// lazy build apart from the queries. Safe alongside queries.
     void prebuild(std::span<const Ray> rays);
 
     std::string_view name() const override { return "rayclass"; }
@@ -164,8 +174,8 @@ public:
     /// The current figures: they grow as rays split cells.
     AcceleratorStats stats() const override;
 
-    /// Bytes of all candidate lists now held (never above the cap, unless the six root lists
-    /// alone are).
+    /// Bytes of all candidate lists and cells now held (never above the cap, unless the six
+    /// roots alone are).
     std::size_t candidate_bytes() const { return candidate_bytes_.load(std::memory_order_relaxed); }
     /// Splits refused, and cells left with their parent's list, because of
     /// max_candidate_bytes.
@@ -174,54 +184,51 @@ public:
     double box_padding() const { return padding_; }
 
 private:
-    /// A primitive in a cell's list, with where its padded box begins along the face's axis
-    /// (in the coordinate that grows along the rays, rounded down to float).
+    /// A cluster in a cell's list, with where its box begins along the face's axis (in the
+    /// coordinate that grows along the rays).
     struct Candidate {
         float key;
-        std::uint32_t index;
-    };
-    /// A padded primitive box rounded outward to float: half the bytes of an Aabb, so the
-    /// gathers of a split miss the cache less often.
-    struct PaddedBox {
-        float lower[3];
-        float upper[3];
-        Aabb to_aabb() const {
-            Aabb box;
-            box.lower = Point3(lower[0], lower[1], lower[2]);
-            box.upper = Point3(upper[0], upper[1], upper[2]);
-            return box;
-        }
+        std::uint32_t cluster;
     };
     struct Node;
-    /// The candidates one ray must test: a leaf's list (sorted, so the search may stop early)
-    /// or, for a ray too far from the scene for the padding to cover its rounding, a whole
-    /// root list.
+    /// The candidates one ray must search: a cell's sorted list of clusters, or, for a ray
+    /// too far from the scene for the padding to cover its rounding, every bounded primitive.
     struct Search {
         const Candidate* candidates = nullptr;
         std::uint32_t count = 0;
-        bool stops_early = false;
+        bool far = false;
+        /// The face: dominant axis and sign.
+        int axis = 0;
+        bool negative = false;
         /// The ray's coordinate along the face axis is w_origin + t * w_speed.
         double w_origin = 0.0;
         double w_speed = 0.0;
     };
 
-    Search find_candidates(const Ray& ray, TraversalCounters& counters) const;
-    /// The final leaf (one never to be split) of tree `face` holding the ray-space point
-    /// `coordinates` (x, y, z, u, v), splitting the cells on the way that are still too long;
-    /// writes the leaf's cell.
-    const Node* locate(int face, const double coordinates[5], TraversalCounters& counters,
-                       double lower[5], double upper[5]) const;
+    /// The candidates of `ray`; `eager` splits the cells on the way however few rays visited.
+    Search find_candidates(const Ray& ray, TraversalCounters& counters, bool eager = false) const;
+    /// The leaf of tree `face` holding the ray-space point `coordinates` (x, y, z, u, v),
+    /// splitting the cells on the way that are too long and often enough visited (or all of
+    /// them if `eager`); writes the leaf's cell and whether the leaf is final (never split).
+    const Node* locate(int face, const double coordinates[5], bool eager,
+                       TraversalCounters& counters, double lower[5], double upper[5],
+                       bool& final_leaf) const;
     /// Gives `node` two children without lists (or closes it at the memory cap), unless
     /// another thread already has.
     void split(Node& node, int face, int depth, const double lower[5], const double upper[5]) const;
-    /// Filters `child`'s list (cell [lower, upper]) from `parent`'s, unless another thread
-    /// already has; frees the parent's list once both children have theirs.
-    void materialize(Node& parent, Node& child, int face, int depth, const double lower[5],
+    /// Cuts `child`'s list (cell [lower, upper]) from `parent`'s, unless another thread
+    /// already has.
+    void materialize(const Node& parent, Node& child, int face, const double lower[5],
                      const double upper[5]) const;
     std::mutex& lock_of(const Node& node) const;
     void subdivide(Node& node, int face, int depth, double lower[5], double upper[5]);
+    /// The widths across the rays (along b and c) of the beam of cell [lower, upper] of
+    /// tree `face`, where it leaves the scene.
+    void beam_widths(int face, const double lower[5], const double upper[5], double& width_b,
+                     double& width_c) const;
     int split_axis(int face, int depth, const double lower[5], const double upper[5]) const;
     void root_cell(double lower[5], double upper[5]) const;
+    bool is_final(const Node& node, int depth) const;
     template <bool kCount>
     bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
                         TraversalCounters& counters) const;
@@ -230,8 +237,14 @@ private:
 
     const Set* set_ = nullptr;
     RayClassificationConfig config_;
-    /// Padded boxes of the bounded primitives (indexed by primitive).
-    std::vector<PaddedBox> boxes_;
+    /// The clusters: a binary BVH over the padded primitive boxes (detail::BvhNode layout).
+    std::vector<BvhNode, AlignedAllocator<BvhNode>> clusters_;
+    /// Primitive indices in cluster order.
+    std::vector<std::uint32_t> cluster_primitives_;
+    /// Primitives under each cluster.
+    std::vector<std::uint32_t> cluster_sizes_;
+    /// The bounded primitives, for rays too far away for the padding.
+    std::vector<std::uint32_t> bounded_;
     /// Primitives without a finite box (unbounded shapes): every ray tests them.
     std::vector<std::uint32_t> unbounded_;
     /// The union of the padded boxes, padded once more: the origin range of every root.
