@@ -165,10 +165,10 @@ TYPED_TEST(RayClassificationTest, SameHitsAsBruteForceOnInCodeMeshes) {
         /// About half the hits measured with these seeds: the comparisons are meaningful.
         int minimum_hits;
     };
-    const std::vector<Case> cases = {{"integer_cube(8)", test::integer_cube(8), 60000, 20000},
-                                     {"sphere_mesh(5)", test::sphere_mesh(5), 16000, 4000},
-                                     {"triangle soup", triangle_soup(1500, 11), 30000, 2000},
-                                     {"teapot in a stadium", teapot_in_stadium(), 30000, 5000}};
+    const std::vector<Case> cases = {{"integer_cube(8)", test::integer_cube(8), 70000, 35000},
+                                     {"sphere_mesh(5)", test::sphere_mesh(5), 3000, 700},
+                                     {"triangle soup", triangle_soup(1500, 11), 14000, 900},
+                                     {"teapot in a stadium", teapot_in_stadium(), 14000, 2500}};
     int total_rays = 0;
     for (const Case& c : cases) {
         const TriangleSet<TypeParam> set(c.mesh.vertices, c.mesh.triangles);
@@ -210,8 +210,8 @@ TYPED_TEST(RayClassificationTest, RealMeshesAgreeWithCgalAndBruteForce) {
         RayClassification<TriangleSet<TypeParam>> structure;
         structure.build(set);
         const Aabb box = set_bounds(set);
-        std::vector<Ray> rays = camera_rays(box, 2500, 2000);
-        const std::vector<Ray> incoherent = incoherent_rays(box, 2500, 2001);
+        std::vector<Ray> rays = camera_rays(box, 2000, 2000);
+        const std::vector<Ray> incoherent = incoherent_rays(box, 2000, 2001);
         rays.insert(rays.end(), incoherent.begin(), incoherent.end());
         // The reference takes rays from their origin: no clipped or backward intervals here.
         for (Ray& ray : rays) {
@@ -224,16 +224,17 @@ TYPED_TEST(RayClassificationTest, RealMeshesAgreeWithCgalAndBruteForce) {
             test::compare_with_reference(structure, set, reference, ray, scratch, tally);
         tally.print("rayclass " + c.name + (sizeof(TypeParam) == 4 ? " float" : " double"));
         EXPECT_EQ(tally.clear, 0) << c.name;
-        // The rays aim at the mesh's box, which the mesh fills partly: measured 28% hits on
-        // the armadillo.
-        EXPECT_GT(tally.hits, 1000) << c.name;
+        // The rays aim at the mesh's box, which the mesh fills partly: measured 1023 (elephant)
+        // to 1697 (dragon) hits of 4000.
+        EXPECT_GT(tally.hits, 800) << c.name;
         // Ambiguous rays graze an edge to within 64 roundoffs: measured none or a handful.
         EXPECT_LT(tally.ambiguous, tally.rays / 100) << c.name;
         BruteForce<TriangleSet<TypeParam>> brute;
         brute.build(set);
-        std::vector<Ray> some(rays.begin(), rays.begin() + 300);
-        some.insert(some.end(), rays.end() - 300, rays.end());
-        EXPECT_GT(expect_same_as_brute_force(structure, brute, some, c.name), 150) << c.name;
+        std::vector<Ray> some(rays.begin(), rays.begin() + 150);
+        some.insert(some.end(), rays.end() - 150, rays.end());
+        const int some_hits = expect_same_as_brute_force(structure, brute, some, c.name);
+        EXPECT_GT(some_hits, 50) << c.name;  // measured 74 to 121 of 300
     }
 }
 
@@ -326,10 +327,10 @@ TYPED_TEST(RayClassificationTest, RaysStartingInsideAndInsideTheMesh) {
     structure.build(set);
     test::Random random(500);
     std::vector<Ray> rays;
-    for (int i = 0; i < 20000; ++i)
+    for (int i = 0; i < 10000; ++i)
         rays.push_back(Ray{random.unit_vector() * random.uniform(0.0, 0.95),
                            random.unit_vector() * random.uniform(0.25, 4.0)});
-    EXPECT_EQ(expect_same_as_brute_force(structure, brute, rays, "inside"), 20000);
+    EXPECT_EQ(expect_same_as_brute_force(structure, brute, rays, "inside"), 10000);
 }
 
 TYPED_TEST(RayClassificationTest, InvalidRaysHitNothingAndDoNotHang) {
@@ -488,22 +489,24 @@ TYPED_TEST(RayClassificationTest, TinyMemoryCapStillGivesExactAnswers) {
     BruteForce<TriangleSet<TypeParam>> brute;
     brute.build(set);
     const Aabb box = set_bounds(set);
-    std::vector<Ray> rays = camera_rays(box, 5000, 1000);
-    const std::vector<Ray> incoherent = incoherent_rays(box, 5000, 1001);
+    std::vector<Ray> rays = camera_rays(box, 3000, 1000);
+    const std::vector<Ray> incoherent = incoherent_rays(box, 3000, 1001);
     rays.insert(rays.end(), incoherent.begin(), incoherent.end());
-    // The six root lists take 6 * 2048 candidates of 8 bytes: 96 KiB.
+    // A cap of 0 leaves the six roots, each listing the root cluster: every search traverses
+    // the whole cluster hierarchy.
     RayClassification<TriangleSet<TypeParam>> roots_only;
     roots_only.build(set, RayClassificationConfig{.max_candidate_bytes = 0});
-    // Long lists: each candidate's box is tested before the triangle.
     expect_same_as_brute_force(roots_only, brute, rays, "cap 0");
     EXPECT_GT(expect_same_all_hits(roots_only, brute, rays), rays.size() / 2);
     EXPECT_EQ(roots_only.stats().nodes, 6u);
     EXPECT_GT(roots_only.splits_refused(), 0u);
     EXPECT_NE(roots_only.stats().details.find("cap reached"), std::string::npos);
 
-    const std::size_t cap = roots_only.candidate_bytes() + 64 * 1024;
+    // Splitting at every visit, 16 KiB beyond the roots fill up within these rays.
+    const std::size_t cap = roots_only.candidate_bytes() + 16 * 1024;
     RayClassification<TriangleSet<TypeParam>> capped;
-    capped.build(set, RayClassificationConfig{.max_candidate_bytes = cap});
+    capped.build(set,
+                 RayClassificationConfig{.max_candidate_bytes = cap, .visits_before_split = 1});
     expect_same_as_brute_force(capped, brute, rays, "small cap");
     EXPECT_LE(capped.candidate_bytes(), cap);
     EXPECT_GT(capped.splits_refused(), 0u);
@@ -515,7 +518,7 @@ TEST(RayClassification, PrebuildAndBuildDepthGiveTheSameAnswers) {
     const TriangleSet<float> set(mesh.vertices, mesh.triangles);
     BruteForce<TriangleSet<float>> brute;
     brute.build(set);
-    const std::vector<Ray> rays = camera_rays(set_bounds(set), 20000, 1100);
+    const std::vector<Ray> rays = camera_rays(set_bounds(set), 6000, 1100);
 
     RayClassification<TriangleSet<float>> prebuilt;
     prebuilt.build(set);
@@ -539,7 +542,7 @@ TEST(RayClassification, CountedQueriesTestFewPrimitives) {
     brute.build(set);
     RayClassification<TriangleSet<float>> structure;
     structure.build(set);
-    const std::vector<Ray> rays = camera_rays(set_bounds(set), 20000, 1200);
+    const std::vector<Ray> rays = camera_rays(set_bounds(set), 8000, 1200);
     QueryScratch scratch;
     TraversalCounters brute_counts, counts;
     for (const Ray& ray : rays) {
@@ -547,14 +550,15 @@ TEST(RayClassification, CountedQueriesTestFewPrimitives) {
         const bool hit = brute.intersect_counted(ray, a, scratch, brute_counts);
         EXPECT_EQ(structure.intersect_counted(ray, b, scratch, counts), hit);
     }
-    // Brute force tests all 8192 triangles per ray. Camera rays land in leaves of a few dozen
-    // candidates at most, sorted so the search stops soon after the first hit: measured about
-    // 6 per ray; 100 leaves room for a different split rule without letting a broken early
-    // exit or beam test pass.
+    // Brute force tests all 8192 triangles per ray. Camera rays land in cells listing a few
+    // small clusters, sorted so the search stops soon after the first hit: measured 3.3
+    // triangles per ray; 100 leaves room for a different split rule without letting a broken
+    // early exit or beam test pass.
     EXPECT_EQ(brute_counts.primitives_tested, rays.size() * set.size());
     EXPECT_LT(counts.primitives_tested, rays.size() * 100);
-    // Each ray tests the scene box (and, in the rare long leaf, candidate boxes) and visits at
-    // least its leaf.
+    // Each ray tests the scene box and its candidate clusters' boxes (measured 37 per ray,
+    // most in the wide cells of the first rays, before they are split) and visits at least
+    // its leaf (measured 8.4 cells per ray).
     EXPECT_GE(counts.nodes_visited, rays.size());
     EXPECT_GE(counts.boxes_tested, rays.size());
     EXPECT_LT(counts.boxes_tested, rays.size() * 100);
@@ -570,8 +574,9 @@ TEST(RayClassification, ConcurrentQueriesBuildLazilyAndAgree) {
     brute.build(set);
     RayClassification<TriangleSet<float>> eager, capped;
     eager.build(set, RayClassificationConfig{.visits_before_split = 1});
-    constexpr std::size_t kCap = 256 * 1024;
-    capped.build(set, RayClassificationConfig{.max_candidate_bytes = kCap});
+    constexpr std::size_t kCap = 64 * 1024;
+    capped.build(set,
+                 RayClassificationConfig{.max_candidate_bytes = kCap, .visits_before_split = 1});
     const Aabb box = set_bounds(set);
     constexpr int kThreads = 6;
     std::atomic<int> mismatches{0}, hits{0}, rays_done{0};
@@ -579,8 +584,8 @@ TEST(RayClassification, ConcurrentQueriesBuildLazilyAndAgree) {
     for (int k = 0; k < kThreads; ++k) {
         threads.emplace_back([&, k] {
             // Half the threads share a seed so they race for exactly the same cells.
-            std::vector<Ray> rays = camera_rays(box, 4000, 1300 + k / 2);
-            const std::vector<Ray> incoherent = incoherent_rays(box, 2000, 1400 + k);
+            std::vector<Ray> rays = camera_rays(box, 2000, 1300 + k / 2);
+            const std::vector<Ray> incoherent = incoherent_rays(box, 1000, 1400 + k);
             rays.insert(rays.end(), incoherent.begin(), incoherent.end());
             QueryScratch scratch;
             for (const Ray& ray : rays) {
@@ -602,8 +607,8 @@ TEST(RayClassification, ConcurrentQueriesBuildLazilyAndAgree) {
     }
     for (std::thread& thread : threads) thread.join();
     EXPECT_EQ(mismatches.load(), 0);
-    EXPECT_EQ(rays_done.load(), kThreads * 6000);
-    EXPECT_GT(hits.load(), kThreads * 2000);
+    EXPECT_EQ(rays_done.load(), kThreads * 3000);
+    EXPECT_GT(hits.load(), kThreads * 1000);
     EXPECT_GT(eager.stats().nodes, 1000u);
     EXPECT_LE(capped.candidate_bytes(), kCap);
     EXPECT_GT(capped.splits_refused(), 0u);
@@ -667,10 +672,11 @@ TEST(RayClassification, ShapeSetOfTenThousandSpheresAndAPlane) {
     structure.build(set);
     EXPECT_NE(structure.stats().details.find("unbounded 1"), std::string::npos);
     const Aabb box(Point3(-10, -10, 0), Point3(10, 10, 21));
-    std::vector<Ray> rays = camera_rays(box, 6000, 1501);
-    const std::vector<Ray> incoherent = incoherent_rays(box, 6000, 1502);
+    std::vector<Ray> rays = camera_rays(box, 3000, 1501);
+    const std::vector<Ray> incoherent = incoherent_rays(box, 3000, 1502);
     rays.insert(rays.end(), incoherent.begin(), incoherent.end());
-    EXPECT_GT(expect_same_as_brute_force(structure, brute, rays, "spheres"), 6000);
+    const int spheres_hits = expect_same_as_brute_force(structure, brute, rays, "spheres");
+    EXPECT_GT(spheres_hits, 3000);
 }
 
 TEST(RayClassification, DirectionFaceTieRuleAndCoordinates) {
@@ -704,7 +710,7 @@ TEST(RayClassification, BeamTestNeverRejectsABoxThatASampledRayHits) {
     test::Random random(1700);
     const Aabb region(Point3(-10, -10, -10), Point3(10, 10, 10));
     int rejected = 0, hit_boxes = 0;
-    for (int trial = 0; trial < 3000; ++trial) {
+    for (int trial = 0; trial < 1500; ++trial) {
         detail::RayCell cell;
         cell.axis = random.integer(0, 2);
         cell.negative = random.integer(0, 1) == 1;
@@ -746,8 +752,8 @@ TEST(RayClassification, BeamTestNeverRejectsABoxThatASampledRayHits) {
         }
     }
     // The test has teeth: plenty of boxes are hit, and the beam test rejects many others.
-    EXPECT_GT(hit_boxes, 1500);  // measured 2381 of 60000
-    EXPECT_GT(rejected, 30000);  // measured 57049
+    EXPECT_GT(hit_boxes, 700);   // measured 1190 of 30000
+    EXPECT_GT(rejected, 15000);  // measured 28524
 }
 
 TEST(RayClassification, RejectsBadConfigurationsAndIsInTheFactory) {
@@ -792,7 +798,7 @@ TEST(RayClassification, FloatHitsLieWithinTheDocumentedErrorOfTheirBoxes) {
             std::max(box.lower.cwiseAbs().maxCoeff(), box.upper.cwiseAbs().maxCoeff());
         const Aabb around = test::enlarged(box, 1.0);
         QueryScratch scratch;
-        for (int i = 0; i < 20000; ++i) {
+        for (int i = 0; i < 10000; ++i) {
             Ray ray;
             ray.origin = random.in_box(around);
             const auto triangle = static_cast<std::size_t>(random.integer(0, int(set.size()) - 1));
