@@ -57,9 +57,10 @@ constexpr int kDirectionV = 4;
 constexpr int kStackSize = detail::kMaxDepth + 2;
 
 /// The slab test of a float cluster box in double, as conservative as Aabb::intersect (Ize,
-/// "Robust BVH Ray Traversal", JCGT 2013): t_far is moved out by 2 gamma(3) |t_far|.
+/// "Robust BVH Ray Traversal", JCGT 2013): t_far is moved out by 2 gamma(3) |t_far|. Writes
+/// where the ray enters the box (at least t_min).
 inline bool hits_box(const BvhNode& box, const Point3& origin, const Vector3& inverse, double t_min,
-                     double t_max) {
+                     double t_max, double& t_enter) {
     for (int axis = 0; axis < 3; ++axis) {
         double t_near = (double(box.lower[axis]) - origin[axis]) * inverse[axis];
         double t_far = (double(box.upper[axis]) - origin[axis]) * inverse[axis];
@@ -69,7 +70,14 @@ inline bool hits_box(const BvhNode& box, const Point3& origin, const Vector3& in
         t_min = t_near > t_min ? t_near : t_min;
         t_max = t_far < t_max ? t_far : t_max;
     }
+    t_enter = t_min;
     return !(t_min > t_max);
+}
+
+inline bool hits_box(const BvhNode& box, const Point3& origin, const Vector3& inverse, double t_min,
+                     double t_max) {
+    double t_enter;
+    return hits_box(box, origin, inverse, t_min, t_max, t_enter);
 }
 
 /// Where a cluster begins along face axis `axis` in the coordinate that grows along the
@@ -531,8 +539,6 @@ typename RayClassification<Set>::Search RayClassification<Set>::find_candidates(
     }
     search.candidates = leaf->candidates;
     search.count = leaf->count;
-    search.axis = direction.axis;
-    search.negative = direction.negative;
     const double sign = direction.negative ? -1.0 : 1.0;
     search.w_origin = sign * ray.origin[direction.axis];
     search.w_speed = std::abs(ray.direction[direction.axis]);
@@ -593,17 +599,29 @@ bool RayClassification<Set>::intersect_impl(const Ray& ray, HitRecord& record,
     }
     double stop = stop_position(search.w_origin, search.w_speed, best.t);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    std::uint32_t stack[kStackSize];
+    // Clusters whose boxes the ray enters, with where it enters them.
+    struct Entry {
+        std::uint32_t cluster;
+        double t_enter;
+    };
+    Entry stack[kStackSize];
     for (std::uint32_t k = 0; k < search.count; ++k) {
         const Candidate candidate = search.candidates[k];
         // Sorted by where they begin along the face axis: nothing further can beat `best`.
         if (candidate.key > stop) break;
+        double t_enter;
+        ++boxes;
+        if (!hits_box(clusters_[candidate.cluster], ray.origin, inverse_direction, ray.t_min,
+                      best.t, t_enter))
+            continue;
         int top = 0;
-        stack[top++] = candidate.cluster;
+        stack[top++] = Entry{candidate.cluster, t_enter};
         while (top > 0) {
-            const BvhNode& node = clusters_[stack[--top]];
-            ++boxes;
-            if (!hits_box(node, ray.origin, inverse_direction, ray.t_min, best.t)) continue;
+            const Entry entry = stack[--top];
+            // A hit found since the box was tested may lie before it (the same test as
+            // testing the box again).
+            if (entry.t_enter > best.t) continue;
+            const BvhNode& node = clusters_[entry.cluster];
             if (node.is_leaf()) {
                 for (std::uint32_t j = node.offset; j < node.offset + node.count; ++j) {
                     ++tested;
@@ -614,11 +632,24 @@ bool RayClassification<Set>::intersect_impl(const Ray& ray, HitRecord& record,
                 }
                 continue;
             }
-            // The half that begins first along the rays is searched first.
-            const bool swap = begin_key(clusters_[node.offset], search.axis, search.negative) >
-                              begin_key(clusters_[node.offset + 1], search.axis, search.negative);
-            stack[top++] = node.offset + (swap ? 0 : 1);
-            stack[top++] = node.offset + (swap ? 1 : 0);
+            // Both halves are tested together (siblings share a cache line); the one the ray
+            // enters first is searched first.
+            double t_first, t_second;
+            boxes += 2;
+            const bool first = hits_box(clusters_[node.offset], ray.origin, inverse_direction,
+                                        ray.t_min, best.t, t_first);
+            const bool second = hits_box(clusters_[node.offset + 1], ray.origin, inverse_direction,
+                                         ray.t_min, best.t, t_second);
+            const Entry near{node.offset, t_first}, far{node.offset + 1, t_second};
+            if (first && second) {
+                const bool swap = t_second < t_first;
+                stack[top++] = swap ? near : far;
+                stack[top++] = swap ? far : near;
+            } else if (first) {
+                stack[top++] = near;
+            } else if (second) {
+                stack[top++] = far;
+            }
         }
     }
     for (std::uint32_t index : unbounded_) found |= set_->intersect(index, prepared, best);

@@ -43,10 +43,10 @@ struct RayClassificationConfig {
     RayClassificationSplit split = RayClassificationSplit::kNarrowBeam;
     /// A leaf is split only once this many queries have searched it, so a cell that few
     /// incoherent rays reach is searched, not refined for nobody (>= 1; 1: at the first).
-    std::uint32_t visits_before_split = 16;
+    std::uint32_t visits_before_split = 64;
     /// A candidate cluster is replaced by its two halves while it is wider across the rays
     /// than this many times the cell's beam (> 0): smaller values give longer, tighter lists.
-    double cluster_width = 1.0;
+    double cluster_width = 2.0;
     /// Subdivide every cell with more than max_leaf_candidates primitives down to this depth
     /// during build(), before any ray arrives (0: purely lazy).
     int build_depth = 0;
@@ -197,9 +197,6 @@ private:
         const Candidate* candidates = nullptr;
         std::uint32_t count = 0;
         bool far = false;
-        /// The face: dominant axis and sign.
-        int axis = 0;
-        bool negative = false;
         /// The ray's coordinate along the face axis is w_origin + t * w_speed.
         double w_origin = 0.0;
         double w_speed = 0.0;
