@@ -10,7 +10,7 @@
 namespace csgrt {
 
 namespace {
-constexpr std::array<std::string_view, 4> kNames = {"brute", "grid", "hgrid", "bvh"};
+constexpr std::array<std::string_view, 5> kNames = {"brute", "grid", "hgrid", "rayclass", "bvh"};
 
 template <class Structure, class Set, class Config>
 std::unique_ptr<Accelerator<Set>> build(const Set& set, const Config& config) {
@@ -30,6 +30,7 @@ std::unique_ptr<Accelerator<Set>> make_accelerator(std::string_view name, const 
     if (name == "brute") return build<BruteForce<Set>>(set, config.brute_force);
     if (name == "grid") return build<RegularGrid<Set>>(set, config.grid);
     if (name == "hgrid") return build<HierarchicalGrid<Set>>(set, config.hierarchical_grid);
+    if (name == "rayclass") return build<RayClassification<Set>>(set, config.ray_classification);
     if (name == "bvh") return build<Bvh<Set>>(set, config.bvh);
     std::string known;
     for (std::string_view n : kNames) known.append(known.empty() ? "" : ", ").append(n);

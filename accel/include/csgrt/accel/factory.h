@@ -8,6 +8,7 @@
 #include "csgrt/accel/brute_force.h"
 #include "csgrt/accel/bvh.h"
 #include "csgrt/accel/hierarchical_grid.h"
+#include "csgrt/accel/ray_classification.h"
 #include "csgrt/accel/regular_grid.h"
 
 namespace csgrt {
@@ -17,6 +18,7 @@ struct AcceleratorConfig {
     BruteForceConfig brute_force;
     GridConfig grid;
     HierarchicalGridConfig hierarchical_grid;
+    RayClassificationConfig ray_classification;
     BvhConfig bvh;
 };
 
