@@ -9,13 +9,21 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <type_traits>
 
+#include "bvh_simd.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
+// The AVX2 node test is compiled for x86-64 with GCC or Clang only, as functions with their own
+// target attribute: the library itself stays baseline x86-64, and build() picks the AVX2 code
+// only on a CPU that has it.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define CSGRT_BVH_AVX2 1
+#include <immintrin.h>
+#else
+#define CSGRT_BVH_AVX2 0
 #endif
 
 namespace csgrt {
@@ -27,6 +35,9 @@ constexpr double kFloatMax = std::numeric_limits<float>::max();
 /// Beyond this a coordinate or reciprocal direction component is not trusted to the float
 /// slab test (products could overflow or underflow to denormals).
 constexpr double kLargestBoxRayValue = 0x1p100;
+constexpr float kSlack = Bvh<TriangleSet<float>>::kSlabSlack;
+/// Triangles in a BvhTriangleBlock.
+constexpr std::uint32_t kBlockLanes = 4;
 
 /// The largest float <= x (x not NaN).
 float round_down(double x) {
@@ -46,7 +57,54 @@ float round_up(double x) {
     return f;
 }
 
-constexpr float kSlack = Bvh<TriangleSet<float>>::kSlabSlack;
+/// A primitive's box padded by kPrimitivePadding of its size and magnitude and rounded
+/// outward to float.
+void pad_box(const Aabb& box, detail::BuildPrimitive& primitive) {
+    if (box.is_empty()) {
+        for (int axis = 0; axis < 3; ++axis) {
+            primitive.lower[axis] = kFloatInfinity;
+            primitive.upper[axis] = -kFloatInfinity;
+        }
+        return;
+    }
+    const double magnitude =
+        std::max(box.lower.cwiseAbs().maxCoeff(), box.upper.cwiseAbs().maxCoeff());
+    const double padding =
+        Bvh<TriangleSet<float>>::kPrimitivePadding * (magnitude + box.diagonal().maxCoeff());
+    for (int axis = 0; axis < 3; ++axis) {
+        primitive.lower[axis] = round_down(box.lower[axis] - padding);
+        primitive.upper[axis] = round_up(box.upper[axis] + padding);
+    }
+}
+
+/// pad_box for a triangle of float corners, in float: twice the padding, computed with
+/// rounding to nearest, still leaves each bound at least kPrimitivePadding (magnitude + size)
+/// beyond the exact one, because the rounding errors are at most a few 2^-24 of the magnitude,
+/// far below the padding's 2^-18 of it; the padding is at least the smallest normal float, so
+/// tiny coordinates are padded too. Corners that are not all finite take the double path.
+void pad_triangle(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c,
+                  detail::BuildPrimitive& primitive) {
+    const Eigen::Vector3f lower = a.cwiseMin(b).cwiseMin(c);
+    const Eigen::Vector3f upper = a.cwiseMax(b).cwiseMax(c);
+    const float magnitude = std::max(lower.cwiseAbs().maxCoeff(), upper.cwiseAbs().maxCoeff());
+    if (!(magnitude <= std::numeric_limits<float>::max())) {
+        Aabb box;
+        for (const Eigen::Vector3f* corner : {&a, &b, &c}) box.extend(corner->cast<double>());
+        pad_box(box, primitive);
+        return;
+    }
+    constexpr auto kPadding = static_cast<float>(2.0 * Bvh<TriangleSet<float>>::kPrimitivePadding);
+    const float padding = std::max(kPadding * (magnitude + (upper - lower).maxCoeff()),
+                                   std::numeric_limits<float>::min());
+    for (int axis = 0; axis < 3; ++axis) {
+        primitive.lower[axis] = lower[axis] - padding;
+        primitive.upper[axis] = upper[axis] + padding;
+    }
+}
+
+}  // namespace
+
+namespace detail {
 
 /// The ray as the float slab tests see it. The origin is rounded to nearest, as the float
 /// triangle test rounds it, so both tests measure t from the same point.
@@ -56,9 +114,6 @@ constexpr float kSlack = Bvh<TriangleSet<float>>::kSlabSlack;
 /// way, and rounding never flips a sign), so it is folded into the reciprocals: near planes
 /// use (1 - slack) / d, far planes (1 + slack) / d. Otherwise (`signed_interval`) the
 /// traversal widens each interval by its magnitude.
-}  // namespace
-
-namespace detail {
 struct BoxRay {
     float origin[3];
     float inverse_near[3];
@@ -100,12 +155,13 @@ struct BoxRay {
             inverse_far[axis] = inverse * far_scale;
         }
     }
+    /// Offsets (in floats) of the rows of WideBvhNode<kWidth>::bounds that hold each axis'
+    /// near and far planes.
+    int near_row(int axis, int width) const {
+        return (2 * axis + (negative[axis] ? 1 : 0)) * width;
+    }
+    int far_row(int axis, int width) const { return (2 * axis + (negative[axis] ? 0 : 1)) * width; }
 };
-
-}  // namespace detail
-
-namespace {
-using detail::BoxRay;
 
 /// Conservative slab test of one binary node's box: [t_enter, t_exit] clipped to
 /// [t_min, t_max] and widened by the slack; true when it is not empty. An empty box gives an
@@ -131,137 +187,531 @@ bool hit_box(const BvhNode& node, const BoxRay& ray, float t_max, float& t_enter
     return t0 <= t1;
 }
 
-/// The four boxes of a 4-wide node at once, with the arithmetic of hit_box lane by lane.
-struct WideBoxRay {
-    /// Rows of WideBvhNode::bounds holding each axis' near and far planes.
-    std::size_t near_row[3], far_row[3];
-#if defined(__SSE2__)
-    __m128 origin[3], inverse_near[3], inverse_far[3], t_min;
+/// The boxes of a wide node, four at a time, with the arithmetic of hit_box lane by lane
+/// except for NaN slabs: max and min return their second operand when either is NaN, so a
+/// NaN drops one slab (or two), which only widens the interval; t_min and t_max come last, so
+/// the result is never NaN.
+template <int kWidth>
+struct SseNodeTest {
+    Float4 origin[3], inverse_near[3], inverse_far[3], t_min;
+    int near_row[3], far_row[3];
 
-    explicit WideBoxRay(const BoxRay& ray) {
+    explicit SseNodeTest(const BoxRay& ray) {
         for (int axis = 0; axis < 3; ++axis) {
-            origin[axis] = _mm_set1_ps(ray.origin[axis]);
-            inverse_near[axis] = _mm_set1_ps(ray.inverse_near[axis]);
-            inverse_far[axis] = _mm_set1_ps(ray.inverse_far[axis]);
-            near_row[axis] = 2 * axis + (ray.negative[axis] ? 1 : 0);
-            far_row[axis] = 2 * axis + (ray.negative[axis] ? 0 : 1);
+            origin[axis] = Float4::broadcast(ray.origin[axis]);
+            inverse_near[axis] = Float4::broadcast(ray.inverse_near[axis]);
+            inverse_far[axis] = Float4::broadcast(ray.inverse_far[axis]);
+            near_row[axis] = ray.near_row(axis, kWidth);
+            far_row[axis] = ray.far_row(axis, kWidth);
         }
-        t_min = _mm_set1_ps(ray.t_min);
+        t_min = Float4::broadcast(ray.t_min);
     }
 
-    /// Bit i of the result says child i is entered, at t_enter[i].
-    template <bool kSigned, int kWidth>
-    int hit(const WideBvhNode<kWidth>& node, float t_max, float* t_enter) const {
-        int mask = 0;
-        const __m128 t_max4 = _mm_set1_ps(t_max);
+    /// Bit i of the result says child i is entered, at t_enter[i] (16-byte aligned).
+    template <bool kSigned>
+    unsigned hit(const WideBvhNode<kWidth>& node, float t_max, float* t_enter) const {
+        unsigned mask = 0;
+        const Float4 t_max4 = Float4::broadcast(t_max);
         for (int group = 0; group < kWidth; group += 4) {
             const float* bounds = node.bounds[0] + group;
-            __m128 t0 = t_min, t1 = t_max4;
+            Float4 t_near[3], t_far[3];
             for (int axis = 0; axis < 3; ++axis) {
-                const __m128 t_near = _mm_mul_ps(
-                    _mm_sub_ps(_mm_load_ps(bounds + kWidth * near_row[axis]), origin[axis]),
-                    inverse_near[axis]);
-                const __m128 t_far = _mm_mul_ps(
-                    _mm_sub_ps(_mm_load_ps(bounds + kWidth * far_row[axis]), origin[axis]),
-                    inverse_far[axis]);
-                // maxps and minps return their second operand when either is NaN: NaN slabs
-                // are ignored, as in hit_box.
-                t0 = _mm_max_ps(t_near, t0);
-                t1 = _mm_min_ps(t_far, t1);
+                t_near[axis] = (Float4::load_aligned(bounds + near_row[axis]) - origin[axis]) *
+                               inverse_near[axis];
+                t_far[axis] = (Float4::load_aligned(bounds + far_row[axis]) - origin[axis]) *
+                              inverse_far[axis];
             }
+            Float4 t0 = max(max(t_near[0], t_near[1]), max(t_near[2], t_min));
+            Float4 t1 = min(min(t_far[0], t_far[1]), min(t_far[2], t_max4));
             if constexpr (kSigned) {
-                const __m128 sign = _mm_set1_ps(-0.0f), slack = _mm_set1_ps(kSlack);
-                t0 = _mm_sub_ps(t0, _mm_mul_ps(_mm_andnot_ps(sign, t0), slack));
-                t1 = _mm_add_ps(t1, _mm_mul_ps(_mm_andnot_ps(sign, t1), slack));
+                const Float4 slack = Float4::broadcast(kSlack);
+                t0 = t0 - abs(t0) * slack;
+                t1 = t1 + abs(t1) * slack;
             }
-            _mm_store_ps(t_enter + group, t0);
-            mask |= _mm_movemask_ps(_mm_cmple_ps(t0, t1)) << group;
+            t0.store(t_enter + group);
+            mask |= (t0 <= t1).mask() << group;
         }
         return mask;
     }
-#else
-    float origin[3], inverse_near[3], inverse_far[3], t_min;
-
-    explicit WideBoxRay(const BoxRay& ray) {
-        for (int axis = 0; axis < 3; ++axis) {
-            origin[axis] = ray.origin[axis];
-            inverse_near[axis] = ray.inverse_near[axis];
-            inverse_far[axis] = ray.inverse_far[axis];
-            near_row[axis] = 2 * axis + (ray.negative[axis] ? 1 : 0);
-            far_row[axis] = 2 * axis + (ray.negative[axis] ? 0 : 1);
-        }
-        t_min = ray.t_min;
-    }
-
-    template <bool kSigned, int kWidth>
-    int hit(const WideBvhNode<kWidth>& node, float t_max, float* t_enter) const {
-        int mask = 0;
-        for (int lane = 0; lane < kWidth; ++lane) {
-            float t0 = t_min, t1 = t_max;
-            for (int axis = 0; axis < 3; ++axis) {
-                const float t_near =
-                    (node.bounds[near_row[axis]][lane] - origin[axis]) * inverse_near[axis];
-                const float t_far =
-                    (node.bounds[far_row[axis]][lane] - origin[axis]) * inverse_far[axis];
-                t0 = t_near > t0 ? t_near : t0;
-                t1 = t_far < t1 ? t_far : t1;
-            }
-            if constexpr (kSigned) {
-                t0 -= std::abs(t0) * kSlack;
-                t1 += std::abs(t1) * kSlack;
-            }
-            t_enter[lane] = t0;
-            mask |= (t0 <= t1) << lane;
-        }
-        return mask;
-    }
-#endif
 };
 
-/// A primitive's box padded by kPrimitivePadding of its size and magnitude and rounded
-/// outward to float.
-void pad_box(const Aabb& box, detail::BuildPrimitive& primitive) {
-    if (box.is_empty()) {
-        for (int axis = 0; axis < 3; ++axis) {
-            primitive.lower[axis] = kFloatInfinity;
-            primitive.upper[axis] = -kFloatInfinity;
-        }
-        return;
-    }
-    const double magnitude =
-        std::max(box.lower.cwiseAbs().maxCoeff(), box.upper.cwiseAbs().maxCoeff());
-    const double padding =
-        Bvh<TriangleSet<float>>::kPrimitivePadding * (magnitude + box.diagonal().maxCoeff());
-    for (int axis = 0; axis < 3; ++axis) {
-        primitive.lower[axis] = round_down(box.lower[axis] - padding);
-        primitive.upper[axis] = round_up(box.upper[axis] + padding);
-    }
-}
+#if CSGRT_BVH_AVX2
+/// SseNodeTest<8> in one 8-lane AVX step: the same operations, lane by lane, in the same order
+/// (no fused multiply-add), so the same masks and entry distances.
+struct Avx2NodeTest {
+    __m256 origin[3], inverse_near[3], inverse_far[3], t_min;
+    int near_row[3], far_row[3];
 
-/// Starts loading primitive i of the set, where the set lets us know where it is.
+    [[gnu::target("avx2")]] explicit Avx2NodeTest(const BoxRay& ray) {
+        for (int axis = 0; axis < 3; ++axis) {
+            origin[axis] = _mm256_set1_ps(ray.origin[axis]);
+            inverse_near[axis] = _mm256_set1_ps(ray.inverse_near[axis]);
+            inverse_far[axis] = _mm256_set1_ps(ray.inverse_far[axis]);
+            near_row[axis] = ray.near_row(axis, 8);
+            far_row[axis] = ray.far_row(axis, 8);
+        }
+        t_min = _mm256_set1_ps(ray.t_min);
+    }
+
+    /// As SseNodeTest<8>::hit; t_enter must be 32-byte aligned.
+    template <bool kSigned>
+    [[gnu::target("avx2")]] unsigned hit(const Bvh8Node& node, float t_max, float* t_enter) const {
+        const float* bounds = node.bounds[0];
+        __m256 t_near[3], t_far[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            t_near[axis] =
+                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(bounds + near_row[axis]), origin[axis]),
+                              inverse_near[axis]);
+            t_far[axis] =
+                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(bounds + far_row[axis]), origin[axis]),
+                              inverse_far[axis]);
+        }
+        __m256 t0 =
+            _mm256_max_ps(_mm256_max_ps(t_near[0], t_near[1]), _mm256_max_ps(t_near[2], t_min));
+        __m256 t1 = _mm256_min_ps(_mm256_min_ps(t_far[0], t_far[1]),
+                                  _mm256_min_ps(t_far[2], _mm256_set1_ps(t_max)));
+        if constexpr (kSigned) {
+            const __m256 sign = _mm256_set1_ps(-0.0f), slack = _mm256_set1_ps(kSlack);
+            t0 = _mm256_sub_ps(t0, _mm256_mul_ps(_mm256_andnot_ps(sign, t0), slack));
+            t1 = _mm256_add_ps(t1, _mm256_mul_ps(_mm256_andnot_ps(sign, t1), slack));
+        }
+        _mm256_store_ps(t_enter, t0);
+        return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+    }
+};
+#endif
+
+/// Four triangles of a block sheared into the frame of the ray, lane by lane.
+struct ShearedBlock {
+    Float4 x[3], y[3], z[3];
+
+    /// Lane l as the set's scalar test would have computed it.
+    TriangleSet<float>::ShearedTriangle lane(int l) const {
+        alignas(16) float values[9][4];
+        for (int k = 0; k < 3; ++k) {
+            x[k].store(values[k]);
+            y[k].store(values[3 + k]);
+            z[k].store(values[6 + k]);
+        }
+        TriangleSet<float>::ShearedTriangle triangle;
+        for (int k = 0; k < 3; ++k) {
+            triangle.x[k] = values[k][l];
+            triangle.y[k] = values[3 + k][l];
+            triangle.z[k] = values[6 + k][l];
+        }
+        return triangle;
+    }
+};
+
+/// The first half of TriangleSet<float>'s test on the four triangles of a block at once: the
+/// same float operations as TriangleSet::shear and the edge functions of hit_sheared, lane by
+/// lane, so the values are the scalar test's bits. A lane whose three edge functions are
+/// non-zero and of mixed signs is a miss for the scalar test too (it only recomputes exact
+/// zeros); every other lane is left to TriangleSet::hit_sheared.
+struct BlockRay {
+    /// The origin's and the shear's components, on the permuted axes (x, y, z of the test).
+    Float4 origin[3], shear_x, shear_y;
+    int axis[3];
+
+    explicit BlockRay(const TriangleSet<float>::PreparedRay& ray)
+        : shear_x(Float4::broadcast(ray.shear_x)), shear_y(Float4::broadcast(ray.shear_y)) {
+        axis[0] = ray.axis_x;
+        axis[1] = ray.axis_y;
+        axis[2] = ray.axis_z;
+        for (int a = 0; a < 3; ++a) origin[a] = Float4::broadcast(ray.origin[axis[a]]);
+    }
+
+    /// The lanes that may hit (bit l for lane l), and the block sheared for those.
+    unsigned candidates(const BvhTriangleBlock& block, ShearedBlock& sheared) const {
+        for (int k = 0; k < 3; ++k) {
+            const Float4 px = Float4::load_aligned(block.corners[k][axis[0]]) - origin[0];
+            const Float4 py = Float4::load_aligned(block.corners[k][axis[1]]) - origin[1];
+            const Float4 pz = Float4::load_aligned(block.corners[k][axis[2]]) - origin[2];
+            sheared.x[k] = px - shear_x * pz;
+            sheared.y[k] = py - shear_y * pz;
+            sheared.z[k] = pz;
+        }
+        const Float4* x = sheared.x;
+        const Float4* y = sheared.y;
+        const Float4 u = x[2] * y[1] - y[2] * x[1];
+        const Float4 v = x[0] * y[2] - y[0] * x[2];
+        const Float4 w = x[1] * y[0] - y[1] * x[0];
+        const Float4 zero = Float4::broadcast(0.0f);
+        const Float4 some_zero = equal(u, zero) | equal(v, zero) | equal(w, zero);
+        const Float4 some_negative = (u < zero) | (v < zero) | (w < zero);
+        const Float4 some_positive = (u > zero) | (v > zero) | (w > zero);
+        return ~and_not(some_zero, some_negative & some_positive).mask() & 0xfu;
+    }
+};
+
+/// Everything the queries do, for each layout and instruction set; a friend of Bvh.
 template <class Set>
-void prefetch_primitive([[maybe_unused]] const Set& set, [[maybe_unused]] std::uint32_t i) {
-#if defined(__SSE2__)
-    if constexpr (requires { set.corner(std::size_t{0}, 0); }) {
-        const char* corners = reinterpret_cast<const char*>(&set.corner(i, 0));
-        _mm_prefetch(corners, _MM_HINT_T0);
-        _mm_prefetch(corners + 3 * sizeof(set.corner(i, 0)) - 1, _MM_HINT_T0);
+struct BvhTraversal {
+    using Tree = Bvh<Set>;
+    static constexpr bool kBlockSet = std::is_same_v<Set, TriangleSet<float>>;
+
+    struct BinaryEntry {
+        std::uint32_t node;
+        float t_enter;
+    };
+    struct WideEntry {
+        std::uint32_t first;
+        std::uint32_t count;
+        float t_enter;
+    };
+
+    /// Visits every leaf the ray may hit within [t_min, t_max], nearest entry first. `leaf`
+    /// is called as leaf(first, count, t_max) with the leaf's reference (see Bvh::
+    /// binary_nodes) and the float upper bound of the interval, which it may lower; it
+    /// returns true to stop.
+    template <bool kCount, class Leaf>
+    static void traverse(const Tree& bvh, const Ray& ray, TraversalCounters& counters, Leaf& leaf) {
+        const BoxRay box_ray(ray);
+        if (bvh.config_.width == 8) {
+#if CSGRT_BVH_AVX2
+            if (bvh.use_avx2_)
+                return traverse_avx2<kCount>(bvh, box_ray, ray.t_max, counters, leaf);
+#endif
+            if (box_ray.signed_interval) {
+                return traverse_wide<kCount, true, SseNodeTest<8>>(bvh, bvh.nodes_8_, box_ray,
+                                                                   ray.t_max, counters, leaf);
+            }
+            return traverse_wide<kCount, false, SseNodeTest<8>>(bvh, bvh.nodes_8_, box_ray,
+                                                                ray.t_max, counters, leaf);
+        }
+        if (bvh.config_.width == 4) {
+            if (box_ray.signed_interval) {
+                return traverse_wide<kCount, true, SseNodeTest<4>>(bvh, bvh.nodes_4_, box_ray,
+                                                                   ray.t_max, counters, leaf);
+            }
+            return traverse_wide<kCount, false, SseNodeTest<4>>(bvh, bvh.nodes_4_, box_ray,
+                                                                ray.t_max, counters, leaf);
+        }
+        if (box_ray.signed_interval) {
+            return traverse_binary<kCount, true>(bvh, box_ray, ray.t_max, counters, leaf);
+        }
+        traverse_binary<kCount, false>(bvh, box_ray, ray.t_max, counters, leaf);
+    }
+
+#if CSGRT_BVH_AVX2
+    /// The 8-wide traversal with the AVX2 node test. `flatten` inlines everything it calls
+    /// (the traversal, the leaf visitor, the triangle test), so all of it is compiled for
+    /// AVX2 here and nowhere else.
+    template <bool kCount, class Leaf>
+    [[gnu::target("avx2"), gnu::flatten]] static void traverse_avx2(const Tree& bvh,
+                                                                    const BoxRay& box_ray,
+                                                                    double t_max,
+                                                                    TraversalCounters& counters,
+                                                                    Leaf& leaf) {
+        if (box_ray.signed_interval) {
+            traverse_wide<kCount, true, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray, t_max, counters,
+                                                      leaf);
+        } else {
+            traverse_wide<kCount, false, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray, t_max, counters,
+                                                       leaf);
+        }
     }
 #endif
-}
 
-/// Stack entries: a node (binary) or a child reference (wide), and its entry distance.
-struct BinaryEntry {
-    std::uint32_t node;
-    float t_enter;
-};
-struct WideEntry {
-    std::uint32_t first;
-    std::uint32_t count;
-    float t_enter;
+    /// Starts loading what a leaf or node the traversal will come back to needs: a node's
+    /// cache lines, a leaf's first block, a one-primitive leaf's primitive, or a leaf's
+    /// indices.
+    template <int kWidth>
+    static void prefetch([[maybe_unused]] const Tree& bvh,
+                         [[maybe_unused]] const std::vector<WideBvhNode<kWidth>>& nodes,
+                         [[maybe_unused]] std::uint32_t first,
+                         [[maybe_unused]] std::uint32_t count) {
+#if defined(__SSE2__)
+        auto fetch = [](const void* address, std::size_t bytes) {
+            const char* p = static_cast<const char*>(address);
+            for (std::size_t line = 0; line < bytes; line += 64)
+                _mm_prefetch(p + line, _MM_HINT_T0);
+        };
+        if (count == WideBvhNode<kWidth>::kInterior) {
+            fetch(&nodes[first], sizeof(WideBvhNode<kWidth>));
+        } else if (!bvh.blocks_.empty()) {
+            fetch(&bvh.blocks_[first], sizeof(BvhTriangleBlock) + 32);
+        } else if (count == 1) {
+            if constexpr (requires { bvh.set_->corner(std::size_t{0}, 0); }) {
+                const auto* corners = &bvh.set_->corner(first, 0);
+                fetch(corners, 3 * sizeof(*corners));
+            }
+        } else {
+            fetch(&bvh.indices_[first], sizeof(std::uint32_t));
+        }
+#endif
+    }
+
+    template <bool kCount, bool kSigned, class Leaf>
+    static void traverse_binary(const Tree& bvh, const BoxRay& box_ray, double ray_t_max,
+                                TraversalCounters& counters, Leaf& leaf) {
+        const auto& nodes = bvh.binary_nodes_;
+        if (nodes.empty()) return;
+        float t_max = round_up(ray_t_max);
+        float t_enter;
+        if constexpr (kCount) ++counters.boxes_tested;
+        if (!hit_box<kSigned>(nodes[0], box_ray, t_max, t_enter)) return;
+
+        // Each level pushes at most the far child, so the depth bounds the stack.
+        BinaryEntry stack[kMaxDepth + 1];
+        int size = 0;
+        std::uint32_t index = 0;
+        for (;;) {
+            const BvhNode& node = nodes[index];
+            if constexpr (kCount) ++counters.nodes_visited;
+            if (node.is_leaf()) {
+                if (leaf(node.offset, node.count, t_max)) return;
+            } else {
+                if constexpr (kCount) counters.boxes_tested += 2;
+                float t_left, t_right;
+                const bool left = hit_box<kSigned>(nodes[node.offset], box_ray, t_max, t_left);
+                const bool right =
+                    hit_box<kSigned>(nodes[node.offset + 1], box_ray, t_max, t_right);
+                if (left && right) {
+                    const bool right_first = t_right < t_left;
+                    stack[size++] = {node.offset + (right_first ? 0 : 1),
+                                     right_first ? t_left : t_right};
+                    index = node.offset + (right_first ? 1 : 0);
+                    continue;
+                }
+                if (left || right) {
+                    index = node.offset + (left ? 0 : 1);
+                    continue;
+                }
+            }
+            // Skip entries whose subtree starts beyond the nearest hit found since they were
+            // pushed.
+            do {
+                if (size == 0) return;
+                --size;
+            } while (stack[size].t_enter > t_max);
+            index = stack[size].node;
+        }
+    }
+
+    template <bool kCount, bool kSigned, class NodeTest, int kWidth, class Leaf>
+    static void traverse_wide(const Tree& bvh, const std::vector<WideBvhNode<kWidth>>& nodes,
+                              const BoxRay& box_ray, double ray_t_max, TraversalCounters& counters,
+                              Leaf& leaf) {
+        using Node = WideBvhNode<kWidth>;
+        if (nodes.empty()) return;
+        const NodeTest test(box_ray);
+        float t_max = round_up(ray_t_max);
+
+        // Each level pushes at most kWidth - 1 children.
+        WideEntry stack[(kWidth - 1) * kMaxDepth + 1];
+        WideEntry* top = stack;
+        std::uint32_t first = 0, count = Node::kInterior;
+        alignas(32) float t_enter[kWidth];
+        for (;;) {
+            // Descend through interior nodes, nearest child first, until a leaf or a dead end.
+            while (count == Node::kInterior) {
+                const Node& node = nodes[first];
+                if constexpr (kCount) {
+                    ++counters.nodes_visited;
+                    counters.boxes_tested += kWidth;
+                }
+                unsigned mask = test.template hit<kSigned>(node, t_max, t_enter);
+                if (mask == 0) break;
+                const int nearest = std::countr_zero(mask);
+                mask &= mask - 1;
+                first = node.first[nearest];
+                count = node.count[nearest];
+                if (mask == 0) continue;
+                // Two or more children: push them all, then order the pushed entries so that
+                // the nearest is on top, and take it. Those left waiting are fetched while the
+                // nearest one is traversed.
+                WideEntry* pushed = top;
+                *top++ = WideEntry{first, count, t_enter[nearest]};
+                prefetch(bvh, nodes, first, count);
+                do {
+                    const int slot = std::countr_zero(mask);
+                    mask &= mask - 1;
+                    *top++ = WideEntry{node.first[slot], node.count[slot], t_enter[slot]};
+                    prefetch(bvh, nodes, node.first[slot], node.count[slot]);
+                } while (mask != 0);
+                for (WideEntry* i = pushed + 1; i != top; ++i) {
+                    const WideEntry entry = *i;
+                    WideEntry* j = i;
+                    for (; j != pushed && (j - 1)->t_enter < entry.t_enter; --j) *j = *(j - 1);
+                    *j = entry;
+                }
+                --top;
+                first = top->first;
+                count = top->count;
+            }
+            // An unused slot (count 0) is entered only by rays the float test cannot
+            // represent, which enter every box.
+            if (count != Node::kInterior && count != 0) {
+                if constexpr (kCount) ++counters.nodes_visited;
+                if (leaf(first, count, t_max)) return;
+            }
+            // Skip entries whose subtree starts beyond the nearest hit found since they were
+            // pushed.
+            do {
+                if (top == stack) return;
+                --top;
+            } while (top->t_enter > t_max);
+            first = top->first;
+            count = top->count;
+        }
+    }
+
+    /// Calls visit(primitive) for each primitive of an index leaf, until it returns true.
+    template <class Visit>
+    static bool for_each_primitive(const Tree& bvh, std::uint32_t first, std::uint32_t count,
+                                   Visit&& visit) {
+        if (count == 1) return visit(first);
+        const std::uint32_t* indices = bvh.indices_.data() + first;
+        for (std::uint32_t i = 0; i != count; ++i) {
+            if (visit(indices[i])) return true;
+        }
+        return false;
+    }
+
+    /// Calls visit(index, t, b1, b2) for each triangle of a block leaf that the set's test
+    /// reports as hit (anywhere on the line), until it returns true.
+    template <class Visit>
+    static bool for_each_block_hit(const Tree& bvh, const BlockRay& block_ray, double shear_z,
+                                   std::uint32_t first, std::uint32_t count, Visit&& visit) {
+        const BvhTriangleBlock* block = bvh.blocks_.data() + first;
+        for (std::uint32_t left = count; left != 0; ++block) {
+            const std::uint32_t lanes = std::min(left, kBlockLanes);
+            left -= lanes;
+            ShearedBlock sheared;
+            unsigned candidates = block_ray.candidates(*block, sheared) & ((1u << lanes) - 1u);
+            while (candidates != 0) {
+                const int lane = std::countr_zero(candidates);
+                candidates &= candidates - 1;
+                double t, b1, b2;
+                if (TriangleSet<float>::hit_sheared(sheared.lane(lane), shear_z, t, b1, b2) &&
+                    visit(block->primitive[lane], t, b1, b2)) {
+                    return true;
+                }
+            }
+        }
+        return false;
+    }
+
+    template <bool kCount>
+    static bool intersect(const Tree& bvh, const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                          TraversalCounters& counters) {
+        if (bvh.set_ == nullptr || !is_valid(ray)) return false;
+        const Set& set = *bvh.set_;
+        const auto prepared = set.prepare(ray, scratch);
+        HitRecord best;
+        best.t = ray.t_max;
+        bool found = false;
+        if constexpr (kBlockSet) {
+            if (!bvh.blocks_.empty()) {
+                const BlockRay block_ray(prepared);
+                auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+                    if constexpr (kCount) counters.primitives_tested += count;
+                    bool hit = false;
+                    for_each_block_hit(bvh, block_ray, prepared.shear_z, first, count,
+                                       [&](std::uint32_t index, double t, double b1, double b2) {
+                                           hit |=
+                                               Set::keep_nearest(index, t, b1, b2, prepared, best);
+                                           return false;
+                                       });
+                    if (hit) {
+                        found = true;
+                        t_max = round_up(best.t);
+                    }
+                    return false;
+                };
+                traverse<kCount>(bvh, ray, counters, leaf);
+                if (found) record = best;
+                return found;
+            }
+        }
+        auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+            if constexpr (kCount) counters.primitives_tested += count;
+            bool hit = false;
+            for_each_primitive(bvh, first, count, [&](std::uint32_t i) {
+                hit |= set.intersect(i, prepared, best);
+                return false;
+            });
+            if (hit) {
+                found = true;
+                t_max = round_up(best.t);
+            }
+            return false;
+        };
+        traverse<kCount>(bvh, ray, counters, leaf);
+        if (found) record = best;
+        return found;
+    }
+
+    template <bool kCount>
+    static bool occluded(const Tree& bvh, const Ray& ray, QueryScratch& scratch,
+                         TraversalCounters& counters) {
+        if (bvh.set_ == nullptr || !is_valid(ray)) return false;
+        const Set& set = *bvh.set_;
+        const auto prepared = set.prepare(ray, scratch);
+        bool occluded = false;
+        if constexpr (kBlockSet) {
+            if (!bvh.blocks_.empty()) {
+                const BlockRay block_ray(prepared);
+                auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
+                    if constexpr (kCount) counters.primitives_tested += count;
+                    return occluded = for_each_block_hit(
+                               bvh, block_ray, prepared.shear_z, first, count,
+                               [&](std::uint32_t, double t, double, double) {
+                                   return t >= prepared.t_min && t <= prepared.t_max;
+                               });
+                };
+                traverse<kCount>(bvh, ray, counters, leaf);
+                return occluded;
+            }
+        }
+        auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
+            return occluded = for_each_primitive(bvh, first, count, [&](std::uint32_t i) {
+                       if constexpr (kCount) ++counters.primitives_tested;
+                       return set.occluded(i, prepared);
+                   });
+        };
+        traverse<kCount>(bvh, ray, counters, leaf);
+        return occluded;
+    }
+
+    static void all_hits(const Tree& bvh, const Ray& ray, std::vector<HitRecord>& hits,
+                         QueryScratch& scratch) {
+        if (bvh.set_ == nullptr || !is_valid(ray)) return;
+        const Set& set = *bvh.set_;
+        const auto prepared = set.prepare(ray, scratch);
+        TraversalCounters unused;
+        if constexpr (kBlockSet) {
+            if (!bvh.blocks_.empty()) {
+                const BlockRay block_ray(prepared);
+                auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
+                    return for_each_block_hit(
+                        bvh, block_ray, prepared.shear_z, first, count,
+                        [&](std::uint32_t index, double t, double b1, double b2) {
+                            HitRecord record;
+                            record.t = ray.t_max;
+                            if (Set::keep_nearest(index, t, b1, b2, prepared, record))
+                                hits.push_back(record);
+                            return false;
+                        });
+                };
+                traverse<false>(bvh, ray, unused, leaf);
+                return;
+            }
+        }
+        auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
+            return for_each_primitive(bvh, first, count, [&](std::uint32_t i) {
+                HitRecord record;
+                record.t = ray.t_max;
+                if (set.intersect(i, prepared, record)) hits.push_back(record);
+                return false;
+            });
+        };
+        traverse<false>(bvh, ray, unused, leaf);
+    }
 };
 
-}  // namespace
+}  // namespace detail
 
 template <class Set>
 void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
@@ -276,13 +726,27 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     const auto start = std::chrono::steady_clock::now();
     set_ = &set;
     config_ = config;
+    constexpr bool kBlockSet = detail::BvhTraversal<Set>::kBlockSet;
+    const bool blocks = kBlockSet && config.triangle_blocks;
+    use_avx2_ = false;
+#if CSGRT_BVH_AVX2
+    use_avx2_ = config.width == 8 && config.avx2 && __builtin_cpu_supports("avx2");
+#endif
 
-    std::vector<detail::BuildPrimitive> primitives(set.size());
+    // Left uninitialised here (AlignedAllocator default-initialises) and written in parallel
+    // below, so that the tasks also take the page faults of the 32 bytes a primitive.
+    std::vector<detail::BuildPrimitive, AlignedAllocator<detail::BuildPrimitive>> primitives(
+        set.size());
     auto prepare_range = [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             detail::BuildPrimitive& primitive = primitives[i];
-            pad_box(set.bounds(i), primitive);
+            if constexpr (kBlockSet) {
+                pad_triangle(set.corner(i, 0), set.corner(i, 1), set.corner(i, 2), primitive);
+            } else {
+                pad_box(set.bounds(i), primitive);
+            }
             primitive.index = static_cast<std::uint32_t>(i);
+            primitive.unused = 0.0f;
         }
     };
     const tbb::blocked_range<std::size_t> all(0, set.size(), 4096);
@@ -292,8 +756,26 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
         prepare_range(all);
     }
 
-    detail::BinaryBvh tree = detail::build_binary_bvh(primitives, config);
+    detail::BinaryBvh tree =
+        detail::build_binary_bvh(primitives, config, blocks ? int(kBlockLanes) : 1);
     primitives = {};
+
+    // Leaves name their contents: blocks of four triangles copied in leaf order, or entries
+    // of the index array (a one-primitive leaf names its primitive itself). Leaves cover the
+    // index array in order, so blocks are handed out in that order too.
+    indices_.clear();
+    blocks_.clear();
+    if constexpr (kBlockSet) {
+        if (blocks) fill_blocks(set, tree, config.parallel);
+    }
+    if (!blocks) {
+        for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+            BvhNode& node = tree.nodes[i];
+            if (i != 1 && node.count == 1) node.offset = tree.indices[node.offset];
+        }
+        indices_ = std::move(tree.indices);
+    }
+
     nodes_4_.clear();
     nodes_8_.clear();
     binary_nodes_.clear();
@@ -304,263 +786,114 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     } else {
         binary_nodes_ = std::move(tree.nodes);
     }
-    indices_ = std::move(tree.indices);
 
     stats_ = AcceleratorStats{};
     stats_.name = "bvh";
     stats_.bytes = binary_nodes_.capacity() * sizeof(BvhNode) +
                    nodes_4_.capacity() * sizeof(Bvh4Node) + nodes_8_.capacity() * sizeof(Bvh8Node) +
-                   indices_.capacity() * sizeof(std::uint32_t);
+                   indices_.capacity() * sizeof(std::uint32_t) +
+                   blocks_.capacity() * sizeof(BvhTriangleBlock);
     stats_.nodes = nodes_4_.size() + nodes_8_.size() + binary_nodes_.size();
     stats_.primitives = stats_.references = set.size();
-    char details[200];
+    char details[240];
     std::snprintf(details, sizeof details,
-                  "width %d, depth %d, %zu leaves (%.2f primitives each), SAH cost %.2f, "
-                  "%d bins, %.1f bytes per primitive",
+                  "width %d, depth %d, %zu leaves (%.2f primitives each), %zu blocks, SAH cost "
+                  "%.2f, %d bins, %.1f bytes per primitive%s",
                   config.width, tree.depth, tree.leaves,
-                  tree.leaves ? double(set.size()) / double(tree.leaves) : 0.0, tree.sah_cost,
-                  config.bins, set.size() ? double(stats_.bytes) / double(set.size()) : 0.0);
+                  tree.leaves ? double(set.size()) / double(tree.leaves) : 0.0, blocks_.size(),
+                  tree.sah_cost, config.bins,
+                  set.size() ? double(stats_.bytes) / double(set.size()) : 0.0,
+                  use_avx2_ ? ", AVX2" : "");
     stats_.details = details;
     stats_.build_milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 template <class Set>
-template <bool kCount, class LeafVisitor>
-void Bvh<Set>::traverse(const Ray& ray, TraversalCounters& counters, LeafVisitor&& leaf) const {
-    const BoxRay box_ray(ray);
-    if (config_.width == 4) {
-        if (box_ray.signed_interval) {
-            traverse_wide<kCount, true>(nodes_4_, box_ray, ray.t_max, counters, leaf);
-        } else {
-            traverse_wide<kCount, false>(nodes_4_, box_ray, ray.t_max, counters, leaf);
-        }
-    } else if (config_.width == 8) {
-        if (box_ray.signed_interval) {
-            traverse_wide<kCount, true>(nodes_8_, box_ray, ray.t_max, counters, leaf);
-        } else {
-            traverse_wide<kCount, false>(nodes_8_, box_ray, ray.t_max, counters, leaf);
-        }
-    } else {
-        if (box_ray.signed_interval) {
-            traverse_binary<kCount, true>(box_ray, ray.t_max, counters, leaf);
-        } else {
-            traverse_binary<kCount, false>(box_ray, ray.t_max, counters, leaf);
-        }
-    }
-}
-
-template <class Set>
-template <bool kCount, bool kSigned, class LeafVisitor>
-void Bvh<Set>::traverse_binary(const BoxRay& box_ray, double ray_t_max, TraversalCounters& counters,
-                               LeafVisitor&& leaf) const {
-    if (binary_nodes_.empty()) return;
-    float t_max = round_up(ray_t_max);
-    float t_enter;
-    if constexpr (kCount) ++counters.boxes_tested;
-    if (!hit_box<kSigned>(binary_nodes_[0], box_ray, t_max, t_enter)) return;
-
-    // Each level pushes at most the far child, so the depth bounds the stack.
-    BinaryEntry stack[detail::kMaxDepth + 1];
-    int size = 0;
-    std::uint32_t index = 0;
-    for (;;) {
-        const BvhNode& node = binary_nodes_[index];
-        if constexpr (kCount) ++counters.nodes_visited;
+void Bvh<Set>::fill_blocks(const Set& set, detail::BinaryBvh& tree, bool parallel) {
+    if (tree.nodes.empty()) return;
+    // The leaves in index order: depth first, left child first.
+    std::vector<std::uint32_t> leaves, pending{0};
+    leaves.reserve(tree.leaves);
+    while (!pending.empty()) {
+        const std::uint32_t index = pending.back();
+        pending.pop_back();
+        const BvhNode& node = tree.nodes[index];
         if (node.is_leaf()) {
-            if (leaf(&indices_[node.offset], node.count, t_max)) return;
+            leaves.push_back(index);
         } else {
-            if constexpr (kCount) counters.boxes_tested += 2;
-            float t_left, t_right;
-            const bool left = hit_box<kSigned>(binary_nodes_[node.offset], box_ray, t_max, t_left);
-            const bool right =
-                hit_box<kSigned>(binary_nodes_[node.offset + 1], box_ray, t_max, t_right);
-            if (left && right) {
-                const bool right_first = t_right < t_left;
-                stack[size++] = {node.offset + (right_first ? 0 : 1),
-                                 right_first ? t_left : t_right};
-                index = node.offset + (right_first ? 1 : 0);
-                continue;
-            }
-            if (left || right) {
-                index = node.offset + (left ? 0 : 1);
-                continue;
-            }
+            pending.push_back(node.offset + 1);
+            pending.push_back(node.offset);
         }
-        // Skip entries whose subtree starts beyond the nearest hit found since they were
-        // pushed.
-        do {
-            if (size == 0) return;
-            --size;
-        } while (stack[size].t_enter > t_max);
-        index = stack[size].node;
     }
-}
-
-template <class Set>
-template <bool kCount, bool kSigned, int kWidth, class LeafVisitor>
-void Bvh<Set>::traverse_wide(const std::vector<WideBvhNode<kWidth>>& nodes, const BoxRay& box_ray,
-                             double ray_t_max, TraversalCounters& counters,
-                             LeafVisitor&& leaf) const {
-    using Node = WideBvhNode<kWidth>;
-    if (nodes.empty()) return;
-    const WideBoxRay wide_ray(box_ray);
-    float t_max = round_up(ray_t_max);
-
-    // Each level pushes at most kWidth - 1 children.
-    WideEntry stack[(kWidth - 1) * detail::kMaxDepth + 1];
-    WideEntry* top = stack;
-    std::uint32_t first = 0, count = Node::kInterior;
-    alignas(16) float t_enter[kWidth];
-    // Children that wait on the stack are fetched while the nearest one is traversed: a
-    // node's two cache lines, a one-primitive leaf's primitive, a larger leaf's indices.
-    auto prefetch = [&](std::uint32_t child_first, std::uint32_t child_count) {
-#if defined(__SSE2__)
-        if (child_count == Node::kInterior) {
-            const char* address = reinterpret_cast<const char*>(&nodes[child_first]);
-            for (std::size_t line = 0; line < sizeof(Node); line += 64)
-                _mm_prefetch(address + line, _MM_HINT_T0);
-        } else if (child_count == 1) {
-            prefetch_primitive(*set_, child_first);
-        } else {
-            _mm_prefetch(reinterpret_cast<const char*>(&indices_[child_first]), _MM_HINT_T0);
+    std::vector<std::uint32_t> first_block(leaves.size() + 1, 0);
+    for (std::size_t k = 0; k < leaves.size(); ++k) {
+        first_block[k + 1] =
+            first_block[k] + (tree.nodes[leaves[k]].count + kBlockLanes - 1) / kBlockLanes;
+    }
+    // Every lane of every block is written below: lanes past a leaf's count get zeros and
+    // kNoIndex. The storage is left uninitialised until then.
+    blocks_.resize(first_block.back());
+    auto fill = [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            BvhNode& node = tree.nodes[leaves[k]];
+            for (std::uint32_t slot = 0;
+                 slot != (first_block[k + 1] - first_block[k]) * kBlockLanes; ++slot) {
+                BvhTriangleBlock& block = blocks_[first_block[k] + slot / kBlockLanes];
+                const std::uint32_t lane = slot % kBlockLanes;
+                const bool used = slot < node.count;
+                const std::uint32_t primitive = used ? tree.indices[node.offset + slot] : kNoIndex;
+                block.primitive[lane] = primitive;
+                if constexpr (detail::BvhTraversal<Set>::kBlockSet) {
+                    for (int corner = 0; corner < 3; ++corner) {
+                        for (int axis = 0; axis < 3; ++axis) {
+                            block.corners[corner][axis][lane] =
+                                used ? set.corner(primitive, corner)[axis] : 0.0f;
+                        }
+                    }
+                }
+            }
+            node.offset = first_block[k];
         }
-#endif
     };
-    for (;;) {
-        // Descend through interior nodes, nearest child first, until a leaf or a dead end.
-        while (count == Node::kInterior) {
-            const Node& node = nodes[first];
-            if constexpr (kCount) {
-                ++counters.nodes_visited;
-                counters.boxes_tested += kWidth;
-            }
-            unsigned mask =
-                static_cast<unsigned>(wide_ray.template hit<kSigned>(node, t_max, t_enter));
-            if (mask == 0) break;
-            const int nearest = std::countr_zero(mask);
-            mask &= mask - 1;
-            first = node.first[nearest];
-            count = node.count[nearest];
-            if (mask == 0) continue;
-            // Two or more children: push them all, then order the pushed entries so that
-            // the nearest is on top, and take it.
-            WideEntry* pushed = top;
-            *top++ = WideEntry{first, count, t_enter[nearest]};
-            prefetch(first, count);
-            do {
-                const int slot = std::countr_zero(mask);
-                mask &= mask - 1;
-                *top++ = WideEntry{node.first[slot], node.count[slot], t_enter[slot]};
-                prefetch(node.first[slot], node.count[slot]);
-            } while (mask != 0);
-            for (WideEntry* i = pushed + 1; i != top; ++i) {
-                const WideEntry entry = *i;
-                WideEntry* j = i;
-                for (; j != pushed && (j - 1)->t_enter < entry.t_enter; --j) *j = *(j - 1);
-                *j = entry;
-            }
-            --top;
-            first = top->first;
-            count = top->count;
-        }
-        if (count != Node::kInterior) {
-            if constexpr (kCount) ++counters.nodes_visited;
-            // A one-primitive leaf holds the primitive's index itself.
-            const std::uint32_t* primitives = count == 1 ? &first : &indices_[first];
-            if (leaf(primitives, count, t_max)) return;
-        }
-        // Skip entries whose subtree starts beyond the nearest hit found since they were
-        // pushed.
-        do {
-            if (top == stack) return;
-            --top;
-        } while (top->t_enter > t_max);
-        first = top->first;
-        count = top->count;
+    const tbb::blocked_range<std::size_t> all(0, leaves.size(), 1024);
+    if (parallel) {
+        tbb::parallel_for(all, fill);
+    } else {
+        fill(all);
     }
-}
-
-template <class Set>
-template <bool kCount>
-bool Bvh<Set>::intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                              TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return false;
-    const auto prepared = set_->prepare(ray, scratch);
-    HitRecord best;
-    best.t = ray.t_max;
-    bool found = false;
-    traverse<kCount>(ray, counters,
-                     [&](const std::uint32_t* primitives, std::uint32_t count, float& t_max) {
-                         if constexpr (kCount) counters.primitives_tested += count;
-                         bool hit = false;
-                         for (std::uint32_t i = 0; i != count; ++i)
-                             hit |= set_->intersect(primitives[i], prepared, best);
-                         if (hit) {
-                             found = true;
-                             t_max = round_up(best.t);
-                         }
-                         return false;
-                     });
-    if (found) record = best;
-    return found;
-}
-
-template <class Set>
-template <bool kCount>
-bool Bvh<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
-                             TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return false;
-    const auto prepared = set_->prepare(ray, scratch);
-    bool occluded = false;
-    traverse<kCount>(ray, counters,
-                     [&](const std::uint32_t* primitives, std::uint32_t count, float&) {
-                         for (std::uint32_t i = 0; i != count; ++i) {
-                             if constexpr (kCount) ++counters.primitives_tested;
-                             if (set_->occluded(primitives[i], prepared)) return occluded = true;
-                         }
-                         return false;
-                     });
-    return occluded;
+    tree.indices = {};
 }
 
 template <class Set>
 bool Bvh<Set>::intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
     TraversalCounters unused;
-    return intersect_impl<false>(ray, record, scratch, unused);
+    return detail::BvhTraversal<Set>::template intersect<false>(*this, ray, record, scratch,
+                                                                unused);
 }
 
 template <class Set>
 bool Bvh<Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
     TraversalCounters unused;
-    return occluded_impl<false>(ray, scratch, unused);
+    return detail::BvhTraversal<Set>::template occluded<false>(*this, ray, scratch, unused);
 }
 
 template <class Set>
 bool Bvh<Set>::intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
                                  TraversalCounters& counters) const {
-    return intersect_impl<true>(ray, record, scratch, counters);
+    return detail::BvhTraversal<Set>::template intersect<true>(*this, ray, record, scratch,
+                                                               counters);
 }
 
 template <class Set>
 bool Bvh<Set>::occluded_counted(const Ray& ray, QueryScratch& scratch,
                                 TraversalCounters& counters) const {
-    return occluded_impl<true>(ray, scratch, counters);
+    return detail::BvhTraversal<Set>::template occluded<true>(*this, ray, scratch, counters);
 }
 
 template <class Set>
 void Bvh<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const {
-    if (set_ == nullptr || !is_valid(ray)) return;
-    const auto prepared = set_->prepare(ray, scratch);
-    TraversalCounters unused;
-    traverse<false>(ray, unused, [&](const std::uint32_t* primitives, std::uint32_t count, float&) {
-        for (std::uint32_t i = 0; i != count; ++i) {
-            HitRecord record;
-            record.t = ray.t_max;
-            if (set_->intersect(primitives[i], prepared, record)) hits.push_back(record);
-        }
-        return false;
-    });
+    detail::BvhTraversal<Set>::all_hits(*this, ray, hits, scratch);
 }
 
 template class Bvh<TriangleSet<float>>;

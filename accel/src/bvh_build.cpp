@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <new>
 
 #include "bvh_simd.h"
 #include "csgrt/accel/bvh_build.h"
@@ -17,10 +20,11 @@ namespace {
 
 constexpr float kInfinityFloat = std::numeric_limits<float>::infinity();
 constexpr int kMaxBins = 256;
-/// Below these sizes a subtree is built, or a node binned, on one thread: smaller tasks cost
-/// more to schedule than they save.
+/// Below this size a subtree is built on one thread: smaller tasks cost more to schedule than
+/// they save.
 constexpr std::uint32_t kParallelSubtree = 4096;
-constexpr std::uint32_t kParallelBinning = 1u << 16;
+/// Nodes larger than this find their split on a sample of their primitives.
+constexpr std::uint32_t kSampledBinning = 1u << 14;
 
 /// A float box in two SIMD registers (the fourth lane is unused).
 struct Box {
@@ -60,6 +64,12 @@ struct Box {
         const double x = double(h[0]) - l[0], y = double(h[1]) - l[1], z = double(h[2]) - l[2];
         return x * y + y * z + z * x;
     }
+    /// Half the surface area of the box scaled by `scale` (all lanes equal), in float; the box
+    /// must not be empty.
+    float scaled_half_area(Float4 scale) const {
+        const Float4 extent = (upper - lower) * scale;
+        return (extent * extent.rotate()).sum3();
+    }
 };
 
 /// Twice the centre of a primitive's box: binning only needs it up to scale.
@@ -78,7 +88,7 @@ struct Range {
 /// binning and when partitioning, so both agree on every primitive.
 struct BinMapping {
     Float4 origin, scale, last;
-    float scales[4];
+    float origins[4], scales[4];
 
     BinMapping(const Box& centroids, int bin_count) {
         float l[4], h[4];
@@ -94,6 +104,7 @@ struct BinMapping {
         }
         l[3] = 0.0f;
         scales[3] = 0.0f;
+        std::copy_n(l, 4, origins);
         origin = Float4::load(l);
         scale = Float4::load(scales);
         last = Float4::broadcast(float(bin_count - 1));
@@ -104,6 +115,14 @@ struct BinMapping {
         // last bin, so the truncation always sees a value in [0, bins - 1].
         const Float4 position = (doubled_centroid(p) - origin) * scale;
         min(max(position, Float4::broadcast(0.0f)), last).truncate(out);
+    }
+    /// Whether the primitive's bin on `axis` is at most `bin`: bins() computes the position
+    /// with the same float operations and truncates it after clamping it to [0, bins - 1],
+    /// which gives a bin > `bin` exactly when the position is >= bin + 1 (a NaN position
+    /// goes to bin 0).
+    bool bin_at_most(const BuildPrimitive& p, int axis, int bin) const {
+        const float position = (p.lower[axis] + p.upper[axis] - origins[axis]) * scales[axis];
+        return !(position >= float(bin + 1));
     }
 };
 
@@ -128,48 +147,68 @@ struct Bins {
             ++counts[axis][bin[axis]];
         }
     }
-    void join(const Bins& other) {
-        for (int axis = 0; axis < 3; ++axis) {
-            for (int b = 0; b < bin_count; ++b) {
-                boxes[axis][b].extend(other.boxes[axis][b]);
-                counts[axis][b] += other.counts[axis][b];
-            }
-        }
-    }
 };
 
 struct Split {
     int axis = -1;
     /// Bins 0 .. bin go left.
     int bin = 0;
-    /// Sum over both sides of half area times primitive count.
-    double cost = std::numeric_limits<double>::infinity();
+    /// Sum over both sides of half area times primitive tests (relative to the node's half
+    /// area once find_split returns it).
+    float cost = std::numeric_limits<float>::infinity();
 };
 
 class Builder {
 public:
-    Builder(std::span<BuildPrimitive> primitives, const BvhConfig& config, BinaryBvh& tree)
-        : primitives_(primitives), config_(config), tree_(tree) {}
+    Builder(std::span<BuildPrimitive> primitives, const BvhConfig& config, int leaf_block,
+            BvhNode* nodes)
+        : primitives_(primitives),
+          config_(config),
+          leaf_block_shift_(std::countr_zero(unsigned(leaf_block))),
+          nodes_(nodes) {}
 
-    /// The box and centroid box of all primitives, for the root.
+    /// The number of primitive tests a leaf of `count` primitives costs (a shift, not a
+    /// division: the sweep calls this for every bin).
+    std::uint32_t tests(std::uint32_t count) const {
+        return (count + (1u << leaf_block_shift_) - 1) >> leaf_block_shift_;
+    }
+
+    /// The box and centroid box of all primitives, for the root (in parallel chunks when the
+    /// config says so: min and max give the same boxes in any order).
     Range root() const {
-        Range range{0, static_cast<std::uint32_t>(primitives_.size()), Box::empty(), Box::empty()};
-        for (const BuildPrimitive& p : primitives_) {
-            range.box.extend(Box::of(p));
-            range.centroids.extend(doubled_centroid(p));
-        }
-        return range;
+        using Chunk = tbb::blocked_range<std::size_t>;
+        auto bound = [&](const Chunk& chunk, Range range) {
+            for (std::size_t i = chunk.begin(); i != chunk.end(); ++i) {
+                range.box.extend(Box::of(primitives_[i]));
+                range.centroids.extend(doubled_centroid(primitives_[i]));
+            }
+            return range;
+        };
+        const Range empty{0, static_cast<std::uint32_t>(primitives_.size()), Box::empty(),
+                          Box::empty()};
+        const Chunk all(0, primitives_.size(), 1u << 14);
+        if (!config_.parallel) return bound(all, empty);
+        return tbb::parallel_reduce(all, empty, bound, [](Range a, const Range& b) {
+            a.box.extend(b.box);
+            a.centroids.extend(b.centroids.lower);
+            a.centroids.extend(b.centroids.upper);
+            return a;
+        });
     }
 
     /// Builds the subtree of `range` into node `node`; returns its depth.
     int build(std::uint32_t node, const Range& range, int depth) {
         const std::uint32_t count = range.end - range.begin;
-        BvhNode& target = tree_.nodes[node];
+        BvhNode& target = nodes_[node];
         range.box.store(target.lower, target.upper);
 
         Range left, right;
         bool split = false;
-        if (count == 2 && depth < kMaxSahDepth && !coincident(range.centroids)) {
+        if (tests(count) == 1 && count <= std::uint32_t(config_.max_leaf_size) &&
+            config_.traversal_cost >= config_.intersection_cost) {
+            // A leaf of one test costs intersection_cost; any split costs at least
+            // traversal_cost, which is no less, so the SAH keeps the leaf: no need to bin.
+        } else if (count == 2 && depth < kMaxSahDepth && !coincident(range.centroids)) {
             // Two primitives allow one split, whose SAH cost needs no bins: this is the most
             // common node near the leaves.
             const BuildPrimitive* pair = primitives_.data() + range.begin;
@@ -177,7 +216,7 @@ public:
             const double split_cost = config_.traversal_cost + config_.intersection_cost *
                                                                    (a.half_area() + b.half_area()) /
                                                                    range.box.half_area();
-            if (split_cost < 2.0 * config_.intersection_cost || config_.max_leaf_size < 2) {
+            if (split_cost < config_.intersection_cost * tests(2) || config_.max_leaf_size < 2) {
                 left = {range.begin, range.begin + 1, a, Box::empty()};
                 right = {range.begin + 1, range.end, b, Box::empty()};
                 left.centroids.extend(doubled_centroid(pair[0]));
@@ -188,9 +227,9 @@ public:
             const int bin_count = bins_for(count);
             const BinMapping mapping(range.centroids, bin_count);
             const Split best = find_split(range, mapping, bin_count);
-            const double leaf_cost = config_.intersection_cost * count;
-            const double split_cost = config_.traversal_cost +
-                                      config_.intersection_cost * best.cost / range.box.half_area();
+            const double leaf_cost = config_.intersection_cost * tests(count);
+            const double split_cost =
+                config_.traversal_cost + config_.intersection_cost * best.cost;
             const bool split_pays = best.axis >= 0 && split_cost < leaf_cost;
             if (best.axis >= 0 && (split_pays || count > std::uint32_t(config_.max_leaf_size))) {
                 partition(range, mapping, best, left, right);
@@ -242,55 +281,57 @@ private:
 
     /// The cheapest binned split over all three axes (axis -1 when the centroids coincide).
     Split find_split(const Range& range, const BinMapping& mapping, int bin_count) const {
+        // Nodes of more than kSampledBinning primitives bin an evenly strided sample of
+        // kSampledBinning / 2 to kSampledBinning of them: the bins' counts and boxes are then
+        // estimates, which pick the split plane about as well, while binning costs a fraction
+        // (the partition still moves and bounds every primitive). The approximation is that of
+        // Hunt, Mark and Stoll, "Fast kd-tree Construction with an Adaptive Error-Bounded
+        // Heuristic", 2006.
         Bins bins(bin_count);
-        if (!config_.parallel || range.end - range.begin < kParallelBinning) {
-            for (std::uint32_t i = range.begin; i != range.end; ++i)
-                bins.add(mapping, primitives_[i]);
-        } else {
-            // Each task bins a chunk into its own bins; the results are summed.
-            struct Body {
-                const Builder& builder;
-                const BinMapping& mapping;
-                Bins bins;
-                Body(const Builder& b, const BinMapping& m, int n)
-                    : builder(b), mapping(m), bins(n) {}
-                Body(Body& other, tbb::split)
-                    : builder(other.builder), mapping(other.mapping), bins(other.bins.bin_count) {}
-                void operator()(const tbb::blocked_range<std::uint32_t>& chunk) {
-                    for (std::uint32_t i = chunk.begin(); i != chunk.end(); ++i)
-                        bins.add(mapping, builder.primitives_[i]);
-                }
-                void join(const Body& other) { bins.join(other.bins); }
-            };
-            Body body(*this, mapping, bin_count);
-            tbb::parallel_reduce(
-                tbb::blocked_range<std::uint32_t>(range.begin, range.end, 1u << 14), body);
-            bins = body.bins;
-        }
+        const std::uint32_t count = range.end - range.begin;
+        const std::uint32_t stride = count > kSampledBinning ? count / (kSampledBinning / 2) : 1u;
+        for (std::uint32_t i = range.begin; i < range.end; i += stride)
+            bins.add(mapping, primitives_[i]);
+
+        // The sweep computes areas in float, on extents scaled by a power of two that brings
+        // the node's largest extent just below 1: no product overflows, and scaling by a power
+        // of two loses no precision.
+        float lower[4], upper[4];
+        range.box.lower.store(lower);
+        range.box.upper.store(upper);
+        const float largest =
+            std::max({upper[0] - lower[0], upper[1] - lower[1], upper[2] - lower[2]});
+        const int exponent = largest > 0.0f && std::isfinite(largest) ? std::ilogb(largest) + 1 : 0;
+        const Float4 scale = Float4::broadcast(std::ldexp(1.0f, std::clamp(-exponent, -126, 126)));
+        const float node_area = range.box.scaled_half_area(scale);
 
         Split best;
-        double right_cost[kMaxBins];
+        float right_cost[kMaxBins];
         for (int axis = 0; axis < 3; ++axis) {
             if (mapping.scales[axis] == 0.0f) continue;
             // Sweep from the right, then from the left: the cost of splitting after bin b is
-            // area(left) count(left) + area(right) count(right).
+            // area(left) tests(left) + area(right) tests(right).
             Box right = Box::empty();
             std::uint32_t right_count = 0;
             for (int b = bin_count - 1; b > 0; --b) {
                 right.extend(bins.boxes[axis][b]);
                 right_count += bins.counts[axis][b];
-                right_cost[b] = right_count ? right.half_area() * right_count : -1.0;
+                right_cost[b] =
+                    right_count ? right.scaled_half_area(scale) * float(tests(right_count)) : -1.0f;
             }
             Box left = Box::empty();
             std::uint32_t left_count = 0;
             for (int b = 0; b < bin_count - 1; ++b) {
                 left.extend(bins.boxes[axis][b]);
                 left_count += bins.counts[axis][b];
-                if (left_count == 0 || right_cost[b + 1] < 0.0) continue;
-                const double cost = left.half_area() * left_count + right_cost[b + 1];
+                if (left_count == 0 || right_cost[b + 1] < 0.0f) continue;
+                const float cost =
+                    left.scaled_half_area(scale) * float(tests(left_count)) + right_cost[b + 1];
                 if (cost < best.cost) best = Split{axis, b, cost};
             }
         }
+        // Relative to the node's area, as the SAH wants it.
+        if (best.axis >= 0) best.cost = node_area > 0.0f ? best.cost / node_area : 0.0f;
         return best;
     }
 
@@ -299,9 +340,7 @@ private:
     void partition(const Range& range, const BinMapping& mapping, const Split& split, Range& left,
                    Range& right) {
         auto goes_left = [&](const BuildPrimitive& p) {
-            alignas(16) int bin[4];
-            mapping.bins(p, bin);
-            return bin[split.axis] <= split.bin;
+            return mapping.bin_at_most(p, split.axis, split.bin);
         };
         left = {range.begin, range.begin, Box::empty(), Box::empty()};
         right = {range.end, range.end, Box::empty(), Box::empty()};
@@ -366,7 +405,8 @@ private:
 
     std::span<BuildPrimitive> primitives_;
     const BvhConfig& config_;
-    BinaryBvh& tree_;
+    int leaf_block_shift_;
+    BvhNode* nodes_;
     /// Node 0 is the root and node 1 is unused, so sibling pairs start at even indices.
     std::atomic<std::uint32_t> next_node_{2};
     std::atomic<std::size_t> leaves_{0};
@@ -378,14 +418,15 @@ double node_half_area(const BvhNode& node) {
     return Box{Float4::load(lower), Float4::load(upper)}.half_area();
 }
 
-double sah_cost(const BinaryBvh& tree, const BvhConfig& config) {
+double sah_cost(const BinaryBvh& tree, const BvhConfig& config, int leaf_block) {
     auto half_area = [](const BvhNode& node) { return node_half_area(node); };
     double total = 0.0;
     for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
         if (i == 1) continue;
         const BvhNode& node = tree.nodes[i];
+        const std::uint32_t tests = (node.count + leaf_block - 1) / leaf_block;
         total += half_area(node) *
-                 (node.is_leaf() ? config.intersection_cost * node.count : config.traversal_cost);
+                 (node.is_leaf() ? config.intersection_cost * tests : config.traversal_cost);
     }
     const double root_area = half_area(tree.nodes[0]);
     return root_area > 0.0 ? total / root_area : 0.0;
@@ -442,7 +483,7 @@ std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
             node.bounds[2 * axis + 1][slot] = child.upper[axis];
         }
         if (child.is_leaf()) {
-            node.first[slot] = child.count == 1 ? binary.indices[child.offset] : child.offset;
+            node.first[slot] = child.offset;
             node.count[slot] = child.count;
         } else {
             node.count[slot] = Node::kInterior;
@@ -469,20 +510,27 @@ std::vector<WideBvhNode<kWidth>> collapse_to_wide(const BinaryBvh& binary) {
 template std::vector<Bvh4Node> collapse_to_wide<4>(const BinaryBvh&);
 template std::vector<Bvh8Node> collapse_to_wide<8>(const BinaryBvh&);
 
-BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config) {
+BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config,
+                           int leaf_block) {
     BinaryBvh tree;
     if (primitives.empty()) return tree;
     // A binary tree over n primitives has at most n - 1 interior nodes, so 2 n slots hold the
-    // root, the unused slot and every sibling pair.
-    tree.nodes.resize(2 * primitives.size());
-    Builder builder(primitives, config, tree);
+    // root, the unused slot and every sibling pair. They are left uninitialised: a tree has
+    // about 2 n / (primitives per leaf) nodes, and only the pages written are ever touched.
+    struct Free {
+        void operator()(BvhNode* p) const { ::operator delete(p, std::align_val_t(64)); }
+    };
+    const std::unique_ptr<BvhNode, Free> nodes(static_cast<BvhNode*>(
+        ::operator new(2 * primitives.size() * sizeof(BvhNode), std::align_val_t(64))));
+    nodes.get()[1] = BvhNode{};
+    Builder builder(primitives, config, leaf_block, nodes.get());
     tree.depth = builder.build(0, builder.root(), 0);
-    tree.nodes.resize(primitives.size() == 1 ? 1 : builder.node_count());
-    tree.nodes.shrink_to_fit();
+    tree.nodes.assign(nodes.get(),
+                      nodes.get() + (primitives.size() == 1 ? 1 : builder.node_count()));
     tree.leaves = builder.leaf_count();
     tree.indices.resize(primitives.size());
     for (std::size_t i = 0; i < primitives.size(); ++i) tree.indices[i] = primitives[i].index;
-    tree.sah_cost = sah_cost(tree, config);
+    tree.sah_cost = sah_cost(tree, config, leaf_block);
     return tree;
 }
 

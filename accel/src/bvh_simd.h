@@ -1,6 +1,8 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -9,14 +11,19 @@
 namespace csgrt::detail {
 
 /// Four floats operated on at once: SSE where the target has it (every x86-64), else a plain
-/// loop. Only what the BVH builder needs. min and max follow minps/maxps: when either operand
-/// is NaN they return the second.
+/// loop with the same IEEE results. Comparisons give lane masks (all bits set or clear) as
+/// Float4, which combine with &, | and and_not and reduce to four bits with `mask()`. min and
+/// max follow minps/maxps: when either operand is NaN they return the second.
 struct Float4 {
 #if defined(__SSE2__)
     __m128 v;
 
     static Float4 load(const float* p) {
         return {_mm_loadu_ps(p)};
+    }
+    /// p must be 16-byte aligned.
+    static Float4 load_aligned(const float* p) {
+        return {_mm_load_ps(p)};
     }
     static Float4 broadcast(float x) {
         return {_mm_set1_ps(x)};
@@ -39,6 +46,45 @@ struct Float4 {
     friend Float4 max(Float4 a, Float4 b) {
         return {_mm_max_ps(a.v, b.v)};
     }
+    /// |a| (clears the sign bit).
+    friend Float4 abs(Float4 a) {
+        return {_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)};
+    }
+    friend Float4 operator<(Float4 a, Float4 b) {
+        return {_mm_cmplt_ps(a.v, b.v)};
+    }
+    friend Float4 operator>(Float4 a, Float4 b) {
+        return {_mm_cmpgt_ps(a.v, b.v)};
+    }
+    friend Float4 operator<=(Float4 a, Float4 b) {
+        return {_mm_cmple_ps(a.v, b.v)};
+    }
+    friend Float4 equal(Float4 a, Float4 b) {
+        return {_mm_cmpeq_ps(a.v, b.v)};
+    }
+    friend Float4 operator&(Float4 a, Float4 b) {
+        return {_mm_and_ps(a.v, b.v)};
+    }
+    friend Float4 operator|(Float4 a, Float4 b) {
+        return {_mm_or_ps(a.v, b.v)};
+    }
+    /// ~a & b, bitwise.
+    friend Float4 and_not(Float4 a, Float4 b) {
+        return {_mm_andnot_ps(a.v, b.v)};
+    }
+    /// Bit i is the sign bit of lane i (for a comparison's result: whether it holds).
+    unsigned mask() const {
+        return static_cast<unsigned>(_mm_movemask_ps(v));
+    }
+    /// Lanes 1, 2, 0, 3 (x, y, z -> y, z, x).
+    Float4 rotate() const {
+        return {_mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 0, 2, 1))};
+    }
+    /// Lane 0 + lane 1 + lane 2, added in that order.
+    float sum3() const {
+        const __m128 sum = _mm_add_ss(_mm_add_ss(v, _mm_shuffle_ps(v, v, 1)), _mm_movehl_ps(v, v));
+        return _mm_cvtss_f32(sum);
+    }
     /// Truncates each lane to an int (lanes must be in int range).
     void truncate(int* out) const {
         _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_cvttps_epi32(v));
@@ -49,6 +95,9 @@ struct Float4 {
     static Float4 load(const float* p) {
         return {{p[0], p[1], p[2], p[3]}};
     }
+    static Float4 load_aligned(const float* p) {
+        return load(p);
+    }
     static Float4 broadcast(float x) {
         return {{x, x, x, x}};
     }
@@ -58,6 +107,16 @@ struct Float4 {
     template <class Op>
     static Float4 apply(Float4 a, Float4 b, Op op) {
         return {{op(a.v[0], b.v[0]), op(a.v[1], b.v[1]), op(a.v[2], b.v[2]), op(a.v[3], b.v[3])}};
+    }
+    static float bits(bool condition) {
+        return std::bit_cast<float>(condition ? ~0u : 0u);
+    }
+    template <class Op>
+    static Float4 bitwise(Float4 a, Float4 b, Op op) {
+        return apply(a, b, [op](float x, float y) {
+            return std::bit_cast<float>(
+                op(std::bit_cast<std::uint32_t>(x), std::bit_cast<std::uint32_t>(y)));
+        });
     }
     friend Float4 operator+(Float4 a, Float4 b) {
         return apply(a, b, [](float x, float y) { return x + y; });
@@ -73,6 +132,41 @@ struct Float4 {
     }
     friend Float4 max(Float4 a, Float4 b) {
         return apply(a, b, [](float x, float y) { return x > y ? x : y; });
+    }
+    friend Float4 abs(Float4 a) {
+        return apply(a, a, [](float x, float) { return x < 0.0f ? -x : x; });
+    }
+    friend Float4 operator<(Float4 a, Float4 b) {
+        return apply(a, b, [](float x, float y) { return bits(x < y); });
+    }
+    friend Float4 operator>(Float4 a, Float4 b) {
+        return apply(a, b, [](float x, float y) { return bits(x > y); });
+    }
+    friend Float4 operator<=(Float4 a, Float4 b) {
+        return apply(a, b, [](float x, float y) { return bits(x <= y); });
+    }
+    friend Float4 equal(Float4 a, Float4 b) {
+        return apply(a, b, [](float x, float y) { return bits(x == y); });
+    }
+    friend Float4 operator&(Float4 a, Float4 b) {
+        return bitwise(a, b, [](std::uint32_t x, std::uint32_t y) { return x & y; });
+    }
+    friend Float4 operator|(Float4 a, Float4 b) {
+        return bitwise(a, b, [](std::uint32_t x, std::uint32_t y) { return x | y; });
+    }
+    friend Float4 and_not(Float4 a, Float4 b) {
+        return bitwise(a, b, [](std::uint32_t x, std::uint32_t y) { return ~x & y; });
+    }
+    Float4 rotate() const {
+        return {{v[1], v[2], v[0], v[3]}};
+    }
+    float sum3() const {
+        return v[0] + v[1] + v[2];
+    }
+    unsigned mask() const {
+        unsigned m = 0;
+        for (int i = 0; i < 4; ++i) m |= (std::bit_cast<std::uint32_t>(v[i]) >> 31) << i;
+        return m;
     }
     void truncate(int* out) const {
         for (int i = 0; i < 4; ++i) out[i] = static_cast<int>(v[i]);

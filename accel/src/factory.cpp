@@ -10,7 +10,7 @@
 namespace csgrt {
 
 namespace {
-constexpr std::array<std::string_view, 2> kNames = {"brute", "bvh"};
+constexpr std::array<std::string_view, 5> kNames = {"brute", "grid", "hgrid", "rayclass", "bvh"};
 
 template <class Structure, class Set, class Config>
 std::unique_ptr<Accelerator<Set>> build(const Set& set, const Config& config) {
@@ -28,6 +28,9 @@ template <class Set>
 std::unique_ptr<Accelerator<Set>> make_accelerator(std::string_view name, const Set& set,
                                                    const AcceleratorConfig& config) {
     if (name == "brute") return build<BruteForce<Set>>(set, config.brute_force);
+    if (name == "grid") return build<RegularGrid<Set>>(set, config.grid);
+    if (name == "hgrid") return build<HierarchicalGrid<Set>>(set, config.hierarchical_grid);
+    if (name == "rayclass") return build<RayClassification<Set>>(set, config.ray_classification);
     if (name == "bvh") return build<Bvh<Set>>(set, config.bvh);
     std::string known;
     for (std::string_view n : kNames) known.append(known.empty() ? "" : ", ").append(n);

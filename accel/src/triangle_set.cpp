@@ -49,68 +49,6 @@ typename TriangleSet<Real>::PreparedRay TriangleSet<Real>::prepare(const Ray& ra
     return prepared;
 }
 
-template <class Real>
-bool TriangleSet<Real>::hit(std::size_t i, const PreparedRay& ray, double& t, double& b1,
-                            double& b2) const {
-    const auto& c = corners_[i];
-    const int kx = ray.axis_x, ky = ray.axis_y, kz = ray.axis_z;
-    // Corners relative to the origin, sheared so the ray runs along +z from (0, 0, 0).
-    const Vector a = c[0] - ray.origin;
-    const Vector b = c[1] - ray.origin;
-    const Vector d = c[2] - ray.origin;
-    const Real ax = a[kx] - ray.shear_x * a[kz], ay = a[ky] - ray.shear_y * a[kz];
-    const Real bx = b[kx] - ray.shear_x * b[kz], by = b[ky] - ray.shear_y * b[kz];
-    const Real cx = d[kx] - ray.shear_x * d[kz], cy = d[ky] - ray.shear_y * d[kz];
-    // Edge functions: twice the signed areas of the ray's footprint with each edge. Triangles
-    // that share an edge compute that edge's function from identical inputs, identically.
-    Real u = cx * by - cy * bx;
-    Real v = ax * cy - ay * cx;
-    Real w = bx * ay - by * ax;
-    if constexpr (std::is_same_v<Real, float>) {
-        // An exact zero in float may be a rounding artefact; redo those products in double,
-        // which is exact for products of floats (Woop et al., section 3).
-        if (u == 0.0f || v == 0.0f || w == 0.0f) {
-            u = static_cast<float>(double(cx) * double(by) - double(cy) * double(bx));
-            v = static_cast<float>(double(ax) * double(cy) - double(ay) * double(cx));
-            w = static_cast<float>(double(bx) * double(ay) - double(by) * double(ax));
-        }
-    }
-    // Mixed signs: the footprint is outside. Zeros count as inside, so edges are shared.
-    if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return false;
-    const Real determinant = u + v + w;
-    if (determinant == Real(0)) return false;  // edge-on or degenerate
-    // Woop's T = U Az + V Bz + W Cz with the shear 1 / d_z factored out of the sum and applied
-    // in double, so that t is right for any valid |d| (float would overflow at 1 / 1e-150).
-    const Real scaled_t = u * a[kz] + v * b[kz] + w * d[kz];
-    // The division happens only for triangles the ray crosses; comparing t itself (not the
-    // scaled form) keeps the tie rule exact.
-    const double inverse = 1.0 / double(determinant);
-    t = double(scaled_t) * (ray.shear_z * inverse);
-    b1 = double(v) * inverse;
-    b2 = double(w) * inverse;
-    return true;
-}
-
-template <class Real>
-bool TriangleSet<Real>::intersect(std::size_t i, const PreparedRay& ray, HitRecord& record) const {
-    double t, b1, b2;
-    if (!hit(i, ray, t, b1, b2)) return false;
-    const auto index = static_cast<std::uint32_t>(i);
-    if (!(t >= ray.t_min && (t < record.t || (t == record.t && index < record.primitive))))
-        return false;
-    record.t = t;
-    record.primitive = index;
-    record.u = static_cast<float>(b1);
-    record.v = static_cast<float>(b2);
-    return true;
-}
-
-template <class Real>
-bool TriangleSet<Real>::occluded(std::size_t i, const PreparedRay& ray) const {
-    double t, b1, b2;
-    return hit(i, ray, t, b1, b2) && t >= ray.t_min && t <= ray.t_max;
-}
-
 template class TriangleSet<float>;
 template class TriangleSet<double>;
 

@@ -24,22 +24,31 @@ void Camera::validate() const {
 }
 
 Ray Camera::generate_ray(double x, double y, double aspect) const {
+    return CameraFilm(*this, aspect).ray(x, y);
+}
+
+CameraFilm::CameraFilm(const Camera& camera, double aspect)
+    : pinhole_(camera.projection == Camera::Projection::Pinhole),
+      position_(camera.position),
+      aspect_(aspect) {
     // An orthonormal frame: forward into the scene, right and down along the film's axes.
-    const Vector3 forward = (look_at - position).normalized();
-    const Vector3 right = forward.cross(up).normalized();
-    const Vector3 down = forward.cross(right);
-    const double film_x = (2.0 * x - 1.0) * aspect;
+    forward_ = (camera.look_at - camera.position).normalized();
+    right_ = forward_.cross(camera.up).normalized();
+    down_ = forward_.cross(right_);
+    half_height_ = pinhole_ ? std::tan(0.5 * camera.vertical_fov_degrees * kPi / 180.0)
+                            : 0.5 * camera.orthographic_height;
+}
+
+Ray CameraFilm::ray(double x, double y) const {
+    const double film_x = (2.0 * x - 1.0) * aspect_;
     const double film_y = 2.0 * y - 1.0;
     Ray ray;
-    if (projection == Projection::Pinhole) {
-        const double half_height = std::tan(0.5 * vertical_fov_degrees * kPi / 180.0);
-        ray.origin = position;
-        ray.direction =
-            (forward + half_height * (film_x * right + film_y * down)).normalized();
+    if (pinhole_) {
+        ray.origin = position_;
+        ray.direction = (forward_ + half_height_ * (film_x * right_ + film_y * down_)).normalized();
     } else {
-        const double half_height = 0.5 * orthographic_height;
-        ray.origin = position + half_height * (film_x * right + film_y * down);
-        ray.direction = forward;
+        ray.origin = position_ + half_height_ * (film_x * right_ + film_y * down_);
+        ray.direction = forward_;
     }
     return ray;
 }

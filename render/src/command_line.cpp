@@ -35,10 +35,6 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-/// Every structure the documentation names; a build may register only some of them.
-constexpr std::array<std::string_view, 5> kDocumentedStructures = {"brute", "bvh", "grid", "hgrid",
-                                                                   "rayclass"};
-
 /// Newlines turned into spaces, so every error is one line.
 std::string one_line(std::string text) {
     std::replace(text.begin(), text.end(), '\n', ' ');
@@ -57,11 +53,8 @@ void check_structure(const std::string& name) {
     if (name == "auto") return;
     const auto names = accelerator_names();
     if (std::find(names.begin(), names.end(), name) != names.end()) return;
-    const bool documented = std::find(kDocumentedStructures.begin(), kDocumentedStructures.end(),
-                                      name) != kDocumentedStructures.end();
     throw UsageError("--accel " + name +
-                     (documented ? ": not available in this build" : ": unknown structure") +
-                     " (available: " + available_structures() + ")");
+                     ": unknown structure (available: " + available_structures() + ")");
 }
 
 void check_range(const char* option, long long value, long long low, long long high) {

@@ -26,7 +26,7 @@ namespace {
 struct Frame {
     const Scene& scene;
     const RenderSettings& settings;
-    double aspect;
+    CameraFilm film;
     double scene_magnitude;
     StrataGrid strata;
 };
@@ -107,8 +107,7 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
     const double height = settings.height;
 
     // The AOVs come from one counted ray through the pixel centre.
-    const Ray centre =
-        frame.scene.camera().generate_ray((x + 0.5) / width, (y + 0.5) / height, frame.aspect);
+    const Ray centre = frame.film.ray((x + 0.5) / width, (y + 0.5) / height);
     TraversalCounters counters;
     const std::optional<Hit> centre_hit = frame.scene.intersect_counted(centre, scratch, counters);
     pixel.cost = static_cast<float>(counters.nodes_visited + counters.primitives_tested);
@@ -131,8 +130,7 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
         SampleRandom random = pixel_random(settings.seed, x, y);
         for (int sample = 0; sample < settings.samples_per_pixel; ++sample) {
             const Vector2 film = stratified_sample(frame.strata, sample, random);
-            const Ray ray = frame.scene.camera().generate_ray(
-                (x + film.x()) / width, (y + film.y()) / height, frame.aspect);
+            const Ray ray = frame.film.ray((x + film.x()) / width, (y + film.y()) / height);
             const std::optional<Hit> hit = frame.scene.intersect(ray, scratch);
             if (!hit) continue;
             colour += shade(frame, ray, *hit, scratch, shadow_rays);
@@ -168,7 +166,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
 
     const auto start = std::chrono::steady_clock::now();
     RenderResult result{Image(settings.width, settings.height), {}};
-    const Frame frame{scene, settings, double(settings.width) / settings.height,
+    const Frame frame{scene, settings,
+                      CameraFilm(scene.camera(), double(settings.width) / settings.height),
                       scene_magnitude(scene), strata_for(settings.samples_per_pixel)};
 
     const int tiles_x = (settings.width + settings.tile_size - 1) / settings.tile_size;

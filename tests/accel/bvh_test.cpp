@@ -10,6 +10,7 @@
 #include <sstream>
 #include <thread>
 #include <tuple>
+#include <type_traits>
 
 #include "csgrt/accel/brute_force.h"
 #include "csgrt/accel/factory.h"
@@ -197,17 +198,27 @@ TYPED_TEST(BvhMeshTest, SameHitsAsBruteForceOnEveryMeshAndLayout) {
         if (c.name == "teapot in stadium")
             box = Aabb(Point3(-0.2, -0.2, -0.2), Point3(0.2, 0.2, 0.2));
         const std::vector<Ray> rays = mixed_rays(box, c.rays, 100 + total_rays);
-        for (int width : {8, 4, 2}) {
+        // The default (8-wide, triangle blocks for float sets, AVX2 where the CPU has it) on
+        // every ray; the other layouts and code paths share most of their logic with it, so
+        // a quarter of the rays suffice for each.
+        const std::vector<std::pair<std::string, BvhConfig>> configs = {
+            {"default", BvhConfig{}},
+            {"width 8 SSE", BvhConfig{.avx2 = false}},
+            {"width 8 without blocks", BvhConfig{.triangle_blocks = false}},
+            {"width 4", BvhConfig{.width = 4}},
+            {"width 4 without blocks", BvhConfig{.width = 4, .triangle_blocks = false}},
+            {"width 2", BvhConfig{.width = 2}},
+            {"width 2 without blocks", BvhConfig{.width = 2, .triangle_blocks = false}}};
+        for (const auto& [name, config] : configs) {
             Bvh<TriangleSet<TypeParam>> bvh;
-            bvh.build(set, BvhConfig{.width = width});
-            // The other layouts share the traversal logic; a quarter of the rays suffice.
-            const std::vector<Ray> subset(rays.begin(),
-                                          rays.begin() + (width == 8 ? c.rays : c.rays / 4));
-            const int hits = expect_same_answers<TriangleSet<TypeParam>>(
-                bvh, brute, subset, c.name + " width " + std::to_string(width));
+            bvh.build(set, config);
+            const bool all = name == "default";
+            const std::vector<Ray> subset(rays.begin(), rays.begin() + (all ? c.rays : c.rays / 4));
+            const int hits = expect_same_answers<TriangleSet<TypeParam>>(bvh, brute, subset,
+                                                                         c.name + " " + name);
             // A meaningful share of the rays must hit, or the comparison proves little.
             EXPECT_GT(hits, static_cast<int>(subset.size()) / 5) << c.name;
-            if (width == 8) total_rays += static_cast<int>(subset.size());
+            if (all) total_rays += static_cast<int>(subset.size());
         }
     }
     EXPECT_GE(total_rays, 100000);
@@ -227,9 +238,11 @@ TYPED_TEST(BvhMeshTest, AllHitsEqualBruteForceAsASet) {
             rays[i].t_min = -kInfinity;
             rays[i].t_max = kInfinity;
         }
-        for (int width : {8, 4, 2}) {
+        for (const BvhConfig& config :
+             {BvhConfig{}, BvhConfig{.avx2 = false}, BvhConfig{.triangle_blocks = false},
+              BvhConfig{.width = 4}, BvhConfig{.width = 2}}) {
             Bvh<TriangleSet<TypeParam>> bvh;
-            bvh.build(set, BvhConfig{.width = width});
+            bvh.build(set, config);
             QueryScratch scratch;
             std::size_t total = 0;
             for (const Ray& ray : rays) {
@@ -248,6 +261,134 @@ TYPED_TEST(BvhMeshTest, AllHitsEqualBruteForceAsASet) {
             // A closed mesh is crossed an even number of times by a whole line.
             EXPECT_GT(total, rays.size()) << "too few hits to prove anything";
         }
+    }
+}
+
+TEST(Bvh, TriangleBlocksGiveTheScalarTestsBitsOnEdgeAndVertexRays) {
+    // The SIMD leaves shear four triangles at once and hand each lane they keep to the set's
+    // scalar test (TriangleSet::hit_sheared). A lane dropped that the scalar test would keep,
+    // or a bit computed differently, shows up as a hit missing from all_hits or differing in
+    // t, u or v. Whole lines report every triangle they cross, so all_hits compares the two
+    // tests on every triangle the line meets. Rays aimed exactly at shared vertices and at
+    // points of shared edges make the edge functions zero or tiny: the double-precision
+    // recomputation and the sign rules are exercised there. A million rays.
+    TestMesh fan;
+    fan.vertices.emplace_back(0.0, 0.0, 0.0);
+    for (int k = 0; k < 12; ++k) {
+        const double angle = 2.0 * std::acos(-1.0) * k / 12.0;
+        fan.vertices.emplace_back(std::cos(angle), std::sin(angle), 0.3 * std::sin(3.0 * angle));
+    }
+    for (std::uint32_t k = 0; k < 12; ++k) fan.triangles.push_back({0, k + 1, (k + 1) % 12 + 1});
+    // At a scale of 2^-64 the edge functions' products are denormal floats, with few bits
+    // left: a float zero next to two non-zero values of mixed signs happens, and the exact
+    // recomputation sometimes turns it into a hit. A SIMD leaf that dropped such lanes would
+    // fail here (checked by breaking it on purpose).
+    TestMesh tiny = thin_triangle_soup(300, 19);
+    for (auto& vertex : tiny.vertices) vertex *= 0x1p-64;
+    const std::vector<std::pair<std::string, TestMesh>> meshes = {
+        {"integer_cube(3)", test::integer_cube(3)},
+        {"sphere_mesh(2)", test::sphere_mesh(2)},
+        {"fan", fan},
+        {"soup at 2^-64", tiny}};
+    test::Random random(17);
+    const int rays_per_mesh = 250000;
+    for (const auto& [name, mesh] : meshes) {
+        const TriangleSet<float> set(mesh.vertices, mesh.triangles);
+        BruteForce<TriangleSet<float>> brute;
+        brute.build(set);
+        Bvh<TriangleSet<float>> avx2, sse;
+        avx2.build(set);
+        sse.build(set, BvhConfig{.avx2 = false});
+        ASSERT_FALSE(avx2.triangle_blocks().empty());
+        const Aabb box = mesh_box(mesh);
+        QueryScratch scratch;
+        int failures = 0;
+        std::size_t total_hits = 0;
+        for (int i = 0; i < rays_per_mesh && failures < 10; ++i) {
+            Ray ray;
+            ray.origin = random.in_box(test::enlarged(box, 0.5));
+            const auto& triangle =
+                mesh.triangles[random.integer(0, int(mesh.triangles.size()) - 1)];
+            const Point3& a = mesh.vertices[triangle[random.integer(0, 2)]];
+            const Point3& b = mesh.vertices[triangle[random.integer(0, 2)]];
+            Point3 target;
+            switch (i % 3) {
+                case 0:  // a vertex, exactly
+                    target = a;
+                    break;
+                case 1:  // a point of an edge (or of a vertex when a == b)
+                    target = a + random.uniform() * (b - a);
+                    break;
+                default:
+                    target = random.in_box(box);
+                    break;
+            }
+            ray.direction = target - ray.origin;
+            if (ray.direction.squaredNorm() == 0.0) continue;
+            if (i % 2 == 0) {
+                ray.t_min = -kInfinity;  // the whole line
+            }
+            std::vector<HitRecord> expected;
+            brute.all_hits(ray, expected, scratch);
+            total_hits += expected.size();
+            auto key = [](const HitRecord& r) {
+                return std::tuple(r.primitive, std::bit_cast<std::uint64_t>(r.t),
+                                  std::bit_cast<std::uint32_t>(r.u),
+                                  std::bit_cast<std::uint32_t>(r.v));
+            };
+            std::multiset<decltype(key(HitRecord{}))> want;
+            for (const auto& r : expected) want.insert(key(r));
+            HitRecord expected_record;
+            const Answer expected_answer =
+                Answer::of(brute.intersect(ray, expected_record, scratch), expected_record);
+            for (const Bvh<TriangleSet<float>>* bvh : {&avx2, &sse}) {
+                std::vector<HitRecord> actual;
+                bvh->all_hits(ray, actual, scratch);
+                std::multiset<decltype(key(HitRecord{}))> got;
+                for (const auto& r : actual) got.insert(key(r));
+                HitRecord record;
+                const Answer answer = Answer::of(bvh->intersect(ray, record, scratch), record);
+                if (got != want || answer != expected_answer ||
+                    bvh->occluded(ray, scratch) != expected_answer.hit) {
+                    ++failures;
+                    ADD_FAILURE() << name << " ray " << i << " (" << (bvh == &sse ? "SSE" : "AVX2")
+                                  << "): " << describe(ray) << "\n  all hits " << actual.size()
+                                  << " against " << expected.size() << "; nearest " << answer
+                                  << " against " << expected_answer;
+                }
+            }
+        }
+        // Lines through a closed mesh cross it at least twice; the fan and the soup are
+        // crossed by most of the lines aimed at them.
+        EXPECT_GT(total_hits, std::size_t(rays_per_mesh) / 2) << name;
+    }
+}
+
+TEST(Bvh, Avx2AndSseTraversalsDoTheSameWorkRayByRay) {
+    // The AVX2 node test does the SSE test's float operations in one 8-lane step, so both
+    // enter the same children at the same distances: equal answers and equal counters, ray
+    // by ray. (On a CPU without AVX2 both run the SSE code and the test proves nothing.)
+    const TestMesh mesh = test::sphere_mesh(5);
+    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
+    Bvh<TriangleSet<float>> avx2, sse;
+    avx2.build(set);
+    sse.build(set, BvhConfig{.avx2 = false});
+    EXPECT_FALSE(sse.uses_avx2());
+    if (!avx2.uses_avx2()) GTEST_SKIP() << "this CPU has no AVX2";
+    QueryScratch scratch;
+    for (const Ray& ray : mixed_rays(mesh_box(mesh), 20000, 18)) {
+        TraversalCounters a, b;
+        HitRecord ra, rb;
+        const Answer answer_a = Answer::of(avx2.intersect_counted(ray, ra, scratch, a), ra);
+        const Answer answer_b = Answer::of(sse.intersect_counted(ray, rb, scratch, b), rb);
+        ASSERT_EQ(answer_a, answer_b) << describe(ray);
+        ASSERT_EQ(a.nodes_visited, b.nodes_visited) << describe(ray);
+        ASSERT_EQ(a.boxes_tested, b.boxes_tested) << describe(ray);
+        ASSERT_EQ(a.primitives_tested, b.primitives_tested) << describe(ray);
+        TraversalCounters c, d;
+        ASSERT_EQ(avx2.occluded_counted(ray, scratch, c), sse.occluded_counted(ray, scratch, d));
+        ASSERT_EQ(c.nodes_visited, d.nodes_visited) << describe(ray);
+        ASSERT_EQ(c.primitives_tested, d.primitives_tested) << describe(ray);
     }
 }
 
@@ -400,32 +541,68 @@ TEST(Bvh, InvalidAndExtremeRays) {
     expect_same_answers<TriangleSet<double>>(bvh, brute, extreme, "extreme");
 }
 
-/// Checks the binary tree's invariants: each primitive referenced once, each node's box
-/// containing its children's boxes and its primitives' boxes.
+/// The primitives of the leaf (first, count), as Bvh::binary_nodes documents them. For a
+/// triangle-block leaf it also checks that every used lane holds its triangle's corners bit
+/// for bit and every unused lane is marked unused.
+template <class Set>
+std::vector<std::uint32_t> leaf_primitives(const Bvh<Set>& bvh, const Set& set, std::uint32_t first,
+                                           std::uint32_t count) {
+    std::vector<std::uint32_t> primitives;
+    const auto& blocks = bvh.triangle_blocks();
+    if (!blocks.empty()) {
+        for (std::uint32_t k = 0; k < (count + 3) / 4 * 4; ++k) {
+            EXPECT_LT(first + k / 4, blocks.size());
+            if (first + k / 4 >= blocks.size()) break;
+            const BvhTriangleBlock& block = blocks[first + k / 4];
+            const std::uint32_t primitive = block.primitive[k % 4];
+            if (k >= count) {
+                EXPECT_EQ(primitive, kNoIndex);
+                continue;
+            }
+            EXPECT_LT(primitive, set.size());
+            if (primitive >= set.size()) continue;
+            primitives.push_back(primitive);
+            if constexpr (std::is_same_v<Set, TriangleSet<float>>) {
+                for (int corner = 0; corner < 3; ++corner) {
+                    for (int axis = 0; axis < 3; ++axis) {
+                        EXPECT_EQ(
+                            std::bit_cast<std::uint32_t>(block.corners[corner][axis][k % 4]),
+                            std::bit_cast<std::uint32_t>(set.corner(primitive, corner)[axis]));
+                    }
+                }
+            }
+        }
+    } else if (count == 1) {
+        primitives.push_back(first);  // a one-primitive leaf names its primitive directly
+    } else {
+        const auto& indices = bvh.primitive_indices();
+        EXPECT_LE(first + count, indices.size());
+        for (std::uint32_t k = first; k < first + count && k < indices.size(); ++k)
+            primitives.push_back(indices[k]);
+    }
+    return primitives;
+}
+
+/// Checks the tree's invariants: each primitive reached through exactly one leaf, each node's
+/// box containing its children's boxes and its primitives' boxes.
 template <class Set>
 void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
-    const auto& indices = bvh.primitive_indices();
-    std::vector<int> references(set.size(), 0);
-    for (std::uint32_t index : indices) {
-        ASSERT_LT(index, set.size());
-        ++references[index];
-    }
-    EXPECT_TRUE(std::all_of(references.begin(), references.end(), [](int r) { return r == 1; }));
-
+    std::vector<int> reached(set.size(), 0);
     auto contains = [](const float* lower, const float* upper, const Aabb& box) {
         for (int axis = 0; axis < 3; ++axis) {
             if (!(lower[axis] <= box.lower[axis] && box.upper[axis] <= upper[axis])) return false;
         }
         return true;
     };
-    auto leaf_ok = [&](const float* lower, const float* upper, std::uint32_t first,
-                       std::uint32_t count) {
-        for (std::uint32_t i = first; i < first + count; ++i) {
-            if (!contains(lower, upper, set.bounds(indices[i]))) return false;
+    auto check_leaf = [&](const float* lower, const float* upper, std::uint32_t first,
+                          std::uint32_t count) {
+        const std::vector<std::uint32_t> primitives = leaf_primitives(bvh, set, first, count);
+        EXPECT_EQ(primitives.size(), count);
+        for (std::uint32_t primitive : primitives) {
+            EXPECT_TRUE(contains(lower, upper, set.bounds(primitive))) << primitive;
+            ++reached[primitive];
         }
-        return true;
     };
-    std::size_t leaf_references = 0;
     if (width == 2) {
         const auto& nodes = bvh.binary_nodes();
         ASSERT_FALSE(nodes.empty());
@@ -433,8 +610,7 @@ void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
             if (i == 1) continue;
             const BvhNode& node = nodes[i];
             if (node.is_leaf()) {
-                EXPECT_TRUE(leaf_ok(node.lower, node.upper, node.offset, node.count)) << i;
-                leaf_references += node.count;
+                check_leaf(node.lower, node.upper, node.offset, node.count);
                 continue;
             }
             ASSERT_EQ(node.offset % 2, 0u);  // sibling pairs share a cache line
@@ -451,8 +627,6 @@ void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
             constexpr int kChildren = std::decay_t<decltype(nodes[0])>::kChildren;
             constexpr std::uint32_t kInterior = Bvh4Node::kInterior;
             ASSERT_FALSE(nodes.empty());
-            // Through the leaves, each primitive must be reached exactly once.
-            std::vector<int> reached(set.size(), 0);
             for (std::size_t i = 0; i < nodes.size(); ++i) {
                 const auto& node = nodes[i];
                 for (int slot = 0; slot < kChildren; ++slot) {
@@ -460,19 +634,12 @@ void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
                                             node.bounds[4][slot]};
                     const float upper[3] = {node.bounds[1][slot], node.bounds[3][slot],
                                             node.bounds[5][slot]};
-                    if (node.count[slot] == 1) {
-                        // A one-primitive leaf names its primitive directly.
-                        ASSERT_LT(node.first[slot], set.size());
-                        EXPECT_TRUE(contains(lower, upper, set.bounds(node.first[slot]))) << i;
-                        ++reached[node.first[slot]];
-                        ++leaf_references;
+                    if (node.count[slot] == 0) {
+                        EXPECT_GT(lower[0], upper[0]) << "an unused slot has an empty box";
                         continue;
                     }
                     if (node.count[slot] != kInterior) {
-                        EXPECT_TRUE(leaf_ok(lower, upper, node.first[slot], node.count[slot])) << i;
-                        for (std::uint32_t k = 0; k < node.count[slot]; ++k)
-                            ++reached[indices[node.first[slot] + k]];
-                        leaf_references += node.count[slot];
+                        check_leaf(lower, upper, node.first[slot], node.count[slot]);
                         continue;
                     }
                     ASSERT_GT(node.first[slot], i);  // children follow their parent
@@ -488,39 +655,50 @@ void expect_valid_tree(const Bvh<Set>& bvh, const Set& set, int width) {
                     }
                 }
             }
-            EXPECT_TRUE(std::all_of(reached.begin(), reached.end(), [](int r) { return r == 1; }));
         };
         if (width == 4) check_wide(bvh.nodes_4_wide());
         if (width == 8) check_wide(bvh.nodes_8_wide());
     }
-    EXPECT_EQ(leaf_references, set.size());
+    EXPECT_TRUE(std::all_of(reached.begin(), reached.end(), [](int r) { return r == 1; }))
+        << "a primitive is missing from the leaves, or in two";
 }
 
 TEST(Bvh, TreeInvariantsAndStats) {
     const TestMesh mesh = test::sphere_mesh(6);
     const TriangleSet<float> set(mesh.vertices, mesh.triangles);
-    for (int width : {2, 4, 8}) {
-        Bvh<TriangleSet<float>> bvh;
-        bvh.build(set, BvhConfig{.width = width});
-        expect_valid_tree(bvh, set, width);
-        const AcceleratorStats stats = bvh.stats();
-        EXPECT_EQ(stats.name, "bvh");
-        EXPECT_EQ(stats.primitives, set.size());
-        EXPECT_EQ(stats.references, set.size());
-        EXPECT_GT(stats.nodes, set.size() / 16);
-        EXPECT_GE(stats.build_milliseconds, 0.0);
-        EXPECT_FALSE(stats.details.empty());
-        // The memory target: nodes and indices within 80 bytes a triangle (the triangles
-        // themselves, 36 bytes each in float, are the set's).
-        EXPECT_LE(double(stats.bytes) / double(set.size()), 80.0) << stats.details;
+    for (bool blocks : {true, false}) {
+        for (int width : {2, 4, 8}) {
+            const BvhConfig config{.width = width, .triangle_blocks = blocks};
+            Bvh<TriangleSet<float>> bvh;
+            bvh.build(set, config);
+            expect_valid_tree(bvh, set, width);
+            EXPECT_EQ(bvh.triangle_blocks().empty(), !blocks);
+            EXPECT_EQ(bvh.primitive_indices().empty(), blocks);
+            const AcceleratorStats stats = bvh.stats();
+            EXPECT_EQ(stats.name, "bvh");
+            EXPECT_EQ(stats.primitives, set.size());
+            EXPECT_EQ(stats.references, set.size());
+            // A node holds at most `width` leaves of at most max_leaf_size primitives.
+            EXPECT_GE(stats.nodes, set.size() / std::size_t(width * config.max_leaf_size));
+            EXPECT_GE(stats.build_milliseconds, 0.0);
+            EXPECT_FALSE(stats.details.empty());
+            // The memory target: nodes, indices and triangle blocks within 80 bytes a
+            // triangle (the set's own triangles, 36 bytes each in float, not counted).
+            EXPECT_LE(double(stats.bytes) / double(set.size()), 80.0) << stats.details;
+        }
     }
     // Other sets and configurations keep the invariants too.
     const TestMesh stadium = teapot_in_stadium();
     const TriangleSet<double> stadium_set(stadium.vertices, stadium.triangles);
+    const TriangleSet<float> stadium_floats(stadium.vertices, stadium.triangles);
     for (int bins : {2, 7, 32}) {
+        const BvhConfig config{.bins = bins, .max_leaf_size = 1, .width = 8};
         Bvh<TriangleSet<double>> bvh;
-        bvh.build(stadium_set, BvhConfig{.bins = bins, .max_leaf_size = 1, .width = 8});
+        bvh.build(stadium_set, config);
         expect_valid_tree(bvh, stadium_set, 8);
+        Bvh<TriangleSet<float>> blocks;
+        blocks.build(stadium_floats, config);
+        expect_valid_tree(blocks, stadium_floats, 8);
     }
 }
 

@@ -9,15 +9,16 @@
 namespace csgrt {
 
 namespace detail {
-struct BoxRay;
+template <class Set>
+struct BvhTraversal;
 }
 
 /// A bounding volume hierarchy over a primitive set, built top down with the binned SAH
 /// (Wald 2007, see bvh_build.h) and, by default, collapsed into 8-wide nodes whose boxes are
-/// tested four at a time with SSE. Each primitive is referenced exactly once, by index, in
-/// leaf order (a leaf of one primitive names it directly).
+/// tested eight at a time with AVX2 where the CPU has it, else four at a time with SSE. Each
+/// primitive is referenced exactly once, in leaf order.
 ///
-/// Boxes are float, rounded outward from the set's double boxes after padding them by
+/// Boxes are float, rounded outward from the primitives' boxes after padding them by at least
 /// kPrimitivePadding of their size and magnitude, and the float slab test widens each
 /// [t_enter, t_exit] by the relative kSlabSlack (Ize, "Robust BVH Ray Traversal", JCGT 2013,
 /// does this with 2 gamma(3) for the box test alone). Together they cover the rounding of the
@@ -29,7 +30,9 @@ struct BoxRay;
 /// to visiting every node, which is slow but exact. docs/structures.md has the argument.
 ///
 /// Traversal is near child first (by entry distance), with a fixed stack on the C++ stack;
-/// subtrees whose entry lies beyond the nearest hit so far are skipped.
+/// subtrees whose entry lies beyond the nearest hit so far are skipped. For TriangleSet<float>
+/// the leaves hold their triangles four to a block (BvhConfig::triangle_blocks), tested with
+/// SIMD lane by lane in exactly the set's float arithmetic, so the answers stay the set's own.
 template <class Set>
 class Bvh final : public Accelerator<Set> {
 public:
@@ -53,42 +56,40 @@ public:
     AcceleratorStats stats() const override { return stats_; }
 
     /// The binary nodes (width 2), the 4- or 8-wide nodes (width 4 or 8; each empty for the
-    /// other widths) and the primitive indices in leaf order: for tests of the tree's
-    /// invariants.
+    /// other widths), and the leaves' contents: primitive indices in leaf order, or triangle
+    /// blocks (TriangleSet<float> with triangle_blocks; the indices are then empty). A leaf
+    /// child (offset or first, count) names `count` primitives: with blocks, those of blocks
+    /// first .. first + ceil(count / 4) - 1; else the primitive `first` itself when count is
+    /// 1 (saving a dependent load), or index entries first .. first + count - 1. For tests of
+    /// the tree's invariants.
     const std::vector<BvhNode, AlignedAllocator<BvhNode>>& binary_nodes() const {
         return binary_nodes_;
     }
     const std::vector<Bvh4Node>& nodes_4_wide() const { return nodes_4_; }
     const std::vector<Bvh8Node>& nodes_8_wide() const { return nodes_8_; }
     const std::vector<std::uint32_t>& primitive_indices() const { return indices_; }
+    const std::vector<BvhTriangleBlock, AlignedAllocator<BvhTriangleBlock>>& triangle_blocks()
+        const {
+        return blocks_;
+    }
+    /// Whether queries run the AVX2 node test (BvhConfig::avx2 and a CPU that has it).
+    bool uses_avx2() const { return use_avx2_; }
 
 private:
-    /// Visits every leaf the ray may hit within [t_min, t_max], nearest entry first. `leaf`
-    /// is called as leaf(primitives, count, t_max) with the leaf's primitive indices and the
-    /// float upper bound of the interval, which it may lower; it returns true to stop.
-    template <bool kCount, class LeafVisitor>
-    void traverse(const Ray& ray, TraversalCounters& counters, LeafVisitor&& leaf) const;
-    /// The traversal of each layout, for rays whose interval starts at t >= 0 (kSigned
-    /// false) or may start below 0.
-    template <bool kCount, bool kSigned, class LeafVisitor>
-    void traverse_binary(const detail::BoxRay& box_ray, double t_max, TraversalCounters& counters,
-                         LeafVisitor&& leaf) const;
-    template <bool kCount, bool kSigned, int kWidth, class LeafVisitor>
-    void traverse_wide(const std::vector<WideBvhNode<kWidth>>& nodes, const detail::BoxRay& box_ray,
-                       double t_max, TraversalCounters& counters, LeafVisitor&& leaf) const;
+    friend struct detail::BvhTraversal<Set>;
 
-    template <bool kCount>
-    bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                        TraversalCounters& counters) const;
-    template <bool kCount>
-    bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+    /// Copies the triangles of each leaf of `tree` into blocks_, in leaf order, and points
+    /// the leaves at their first block (TriangleSet<float> only).
+    void fill_blocks(const Set& set, detail::BinaryBvh& tree, bool parallel);
 
     const Set* set_ = nullptr;
     BvhConfig config_;
+    bool use_avx2_ = false;
     std::vector<BvhNode, AlignedAllocator<BvhNode>> binary_nodes_;
     std::vector<Bvh4Node> nodes_4_;
     std::vector<Bvh8Node> nodes_8_;
     std::vector<std::uint32_t> indices_;
+    std::vector<BvhTriangleBlock, AlignedAllocator<BvhTriangleBlock>> blocks_;
     AcceleratorStats stats_;
 };
 

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <new>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace csgrt {
@@ -21,11 +22,20 @@ struct BvhConfig {
     /// SAH cost of one primitive test. Must be > 0.
     double intersection_cost = 1.0;
     /// 8 or 4: the binary tree is collapsed into 8- or 4-wide nodes whose boxes are tested
-    /// four at a time (8, the default, measured about 10% faster than 4 on the armadillo);
-    /// 2: the binary tree is traversed as built.
+    /// four (SSE) or eight (AVX2, see `avx2`) at a time (8, the default, measured about 10% faster
+    /// than 4 on the armadillo); 2: the binary tree is traversed as built.
     int width = 8;
     /// Build large subtrees on several threads (oneTBB); the tree is the same either way.
     bool parallel = true;
+    /// For TriangleSet<float> sets: the BVH keeps its own copy of each leaf's triangles, four
+    /// to a block in leaf order (BvhTriangleBlock), and tests a block's four at once with SIMD,
+    /// as Embree's Triangle4 leaves do; the SAH then prices a leaf by its blocks. Ignored for
+    /// other sets, whose leaves name their primitives and test them one at a time.
+    bool triangle_blocks = true;
+    /// Test 8-wide nodes with AVX2 (one 8-lane slab test) when the CPU has it, as `build`
+    /// checks. The AVX2 and SSE code do the same float operations lane by lane, so answers and
+    /// counters are the same either way; false forces the SSE code.
+    bool avx2 = true;
 };
 
 /// A binary BVH node in 32 bytes: a float box and either two children, stored side by side
@@ -44,12 +54,12 @@ struct BvhNode {
 static_assert(sizeof(BvhNode) == 32);
 
 /// A wide node of kWidth (4 or 8) children: their boxes as structure of arrays
-/// (bounds[2 axis] = lower, bounds[2 axis + 1] = upper, one lane per child; 4 boxes per SIMD
-/// test), and per child a reference: count == kInterior names the wide node `first`;
-/// count == 1 is a leaf whose one primitive is `first` itself (saving a dependent load); any
-/// other count is a leaf of primitive index entries first .. first + count - 1. Unused slots
-/// are empty leaves with an empty box (lower = +inf, upper = -inf), which no slab test hits.
-/// 128 bytes (two cache lines) for 4 children, 256 for 8.
+/// (bounds[2 axis] = lower, bounds[2 axis + 1] = upper, one lane per child; 4 or 8 boxes per
+/// SIMD test), and per child a reference: count == kInterior names the wide node `first`;
+/// count == 0 is an unused slot, whose empty box (lower = +inf, upper = -inf) no slab test
+/// hits; any other count is a leaf of that many primitives starting at `first` (see
+/// Bvh::binary_nodes for what `first` names). 128 bytes (two cache lines) for 4 children, 256
+/// for 8.
 template <int kWidth>
 struct alignas(64) WideBvhNode {
     static constexpr std::uint32_t kInterior = 0xffffffffu;
@@ -62,6 +72,17 @@ struct alignas(64) WideBvhNode {
 using Bvh4Node = WideBvhNode<4>;
 using Bvh8Node = WideBvhNode<8>;
 static_assert(sizeof(Bvh4Node) == 128 && sizeof(Bvh8Node) == 256);
+
+/// Four triangles of a leaf as the BVH stores them for TriangleSet<float> (see
+/// BvhConfig::triangle_blocks): coordinate `axis` of corner k of lane l at
+/// corners[k][axis][l], as the set stores it, and each lane's triangle index. A leaf of n
+/// triangles is ceil(n / 4) consecutive blocks; lanes past n hold zeros and kNoIndex and are
+/// never tested. 160 bytes: 40 a triangle when full.
+struct alignas(32) BvhTriangleBlock {
+    float corners[3][3][4];
+    std::uint32_t primitive[4];
+};
+static_assert(sizeof(BvhTriangleBlock) == 160);
 
 /// An allocator that aligns a vector's storage to `kAlignment` bytes (cache lines).
 template <class T, std::size_t kAlignment = 64>
@@ -78,6 +99,16 @@ struct AlignedAllocator {
         return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(kAlignment)));
     }
     void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(kAlignment)); }
+    /// Elements made without a value are default-initialised (left as they are, for the
+    /// node and block types), so that resizing a large array does not first zero it.
+    template <class U>
+    void construct(U* p) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
     template <class U>
     bool operator==(const AlignedAllocator<U, kAlignment>&) const {
         return true;
@@ -93,7 +124,8 @@ struct alignas(16) BuildPrimitive {
     float lower[3];
     std::uint32_t index;
     float upper[3];
-    float unused = 0.0f;
+    /// Zero (the fourth lane of the box's upper corner).
+    float unused;
 };
 
 /// A binary BVH as built: nodes (see BvhNode), the primitive indices in leaf order, and
@@ -110,13 +142,17 @@ struct BinaryBvh {
 
 /// Builds a binary BVH over `primitives` (reordered in place) with the binned surface-area
 /// heuristic of Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies", 2007.
-/// Beyond a depth of kMaxSahDepth nodes are split at the object median instead, so the depth
-/// stays under kMaxDepth whatever the input. The config is assumed valid.
-BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config);
+/// A leaf of n primitives costs ceil(n / leaf_block) primitive tests (leaf_block, a power of
+/// two: 4 for leaves tested four primitives at a time). Beyond a depth of kMaxSahDepth nodes are
+/// split at the object median instead, so the depth stays under kMaxDepth whatever the input. A
+/// leaf's `offset` is the position of its first primitive in `primitives` and `indices`; leaves
+/// cover those positions in order, left subtrees first. The config is assumed valid.
+BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config,
+                           int leaf_block = 1);
 
 /// Collapses a binary BVH into kWidth-wide nodes ("convert, don't rebuild"): each wide node
 /// takes the place of a binary node and adopts up to kWidth descendants, opening the child
-/// with the largest surface area first. Leaves and primitive indices stay as they are.
+/// with the largest surface area first. Leaves keep their offset and count.
 template <int kWidth>
 std::vector<WideBvhNode<kWidth>> collapse_to_wide(const BinaryBvh& binary);
 

@@ -7,12 +7,18 @@
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/brute_force.h"
 #include "csgrt/accel/bvh.h"
+#include "csgrt/accel/hierarchical_grid.h"
+#include "csgrt/accel/ray_classification.h"
+#include "csgrt/accel/regular_grid.h"
 
 namespace csgrt {
 
 /// The configuration of every structure, so one value can be handed to the factory.
 struct AcceleratorConfig {
     BruteForceConfig brute_force;
+    GridConfig grid;
+    HierarchicalGridConfig hierarchical_grid;
+    RayClassificationConfig ray_classification;
     BvhConfig bvh;
 };
 

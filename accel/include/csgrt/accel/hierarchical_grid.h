@@ -1,0 +1,115 @@
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/regular_grid.h"
+
+namespace csgrt {
+
+struct HierarchicalGridConfig {
+    /// The top grid has about N^top_cells_exponent cells for N primitives. Ize, Shirley and
+    /// Parker, "Grid Creation Strategies for Efficient Ray Tracing", 2007, derive N^0.6 for
+    /// one level of nesting (N^(3 / (3 + 2 d)) for d levels). In [0, 1].
+    double top_cells_exponent = 0.6;
+    /// Cells listing more than this many primitives are considered for a sub-grid (>= 1).
+    int max_primitives_per_cell = 16;
+    /// Density of each sub-grid, in cells per primitive of the cell it refines (> 0).
+    double sub_cells_per_primitive = 2.0;
+    /// Most levels of sub-grids below the top grid, in [0, 8] (0: a plain grid).
+    int max_depth = 3;
+    /// Most cells along one axis of any one grid (>= 1).
+    int max_resolution = 128;
+    /// As GridConfig::triangle_box_test, at every level.
+    bool triangle_box_test = true;
+};
+
+/// A hierarchy of uniform grids after Jevans & Wyvill, "Adaptive Voxel Subdivision for Ray
+/// Tracing", Graphics Interface 1989: a coarse top grid (N^0.6 cells, Ize et al. 2007) whose
+/// crowded cells hold grids of their own, recursively. Unlike Klimaszewski & Sederberg, "Faster
+/// Ray Tracing Using Adaptive Grids", IEEE CG&A 1997, it does not search for uniform regions
+/// spanning several cells: each cell decides alone. A cell gets a sub-grid only when the
+/// sub-grid separates its primitives (no sub-cell lists them all, few references per
+/// primitive) and an estimate of a random ray's cost says it pays: cells it would visit plus
+/// primitives it would test, each weighted by the chance that a ray crossing the cell crosses the
+/// sub-cell (the ratio of surface areas), against testing the cell's list. So cells of identical or
+/// huge primitives stay lists. Each sub-grid is built from its cell's list (not from the whole set)
+/// over the cell's box shrunk to the primitives in it. Traversal runs the regular grid's DDA at
+/// every level, descending into sub-grids, with one mailbox and one stopping rule for the whole
+/// ray.
+template <class Set>
+class HierarchicalGrid final : public Accelerator<Set> {
+public:
+    void build(const Set& set, const HierarchicalGridConfig& config = {});
+
+    std::string_view name() const override { return "hgrid"; }
+    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
+    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
+    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                           TraversalCounters& counters) const override;
+    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
+                          TraversalCounters& counters) const override;
+    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
+                  QueryScratch& scratch) const override;
+    AcceleratorStats stats() const override { return stats_; }
+
+    /// Number of grids (the top grid is grid 0).
+    std::size_t grid_count() const { return grids_.size(); }
+    /// The cells of grid `grid`.
+    const detail::GridGeometry& geometry(std::size_t grid) const { return grids_[grid].geometry; }
+    /// Deepest nesting built (0: only the top grid).
+    int depth() const { return depth_; }
+    /// The list of the innermost cell holding point p (empty outside every grid): what a ray
+    /// through p tests there. For tests and reports.
+    std::span<const std::uint32_t> primitives_at(const Point3& p) const;
+
+private:
+    /// One uniform grid of the hierarchy; its cells are cells_[first_cell ..].
+    struct Grid {
+        detail::GridGeometry geometry;
+        std::uint32_t first_cell;
+    };
+    /// A list of primitives_[begin .. begin + count), or (count == kSubGrid) the grid
+    /// grids_[begin].
+    struct Cell {
+        std::uint32_t begin;
+        std::uint32_t count;
+    };
+    static constexpr std::uint32_t kSubGrid = 0xffffffffu;
+
+    /// Appends a grid with the given cells and CSR lists, refining crowded cells; returns its
+    /// index.
+    std::uint32_t add_grid(const Set& set, const detail::GridGeometry& geometry,
+                           const std::vector<std::uint32_t>& offsets,
+                           const std::vector<std::uint32_t>& lists, int depth);
+    /// Walks grid `grid` and its sub-grids along the ray; true when the visitor asked to stop.
+    template <class Visitor>
+    bool traverse(std::uint32_t grid, const Ray& ray, const Vector3& inverse_direction,
+                  Visitor& visitor) const;
+    template <bool kCount>
+    bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                        TraversalCounters& counters) const;
+    template <bool kCount>
+    bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+
+    const Set* set_ = nullptr;
+    HierarchicalGridConfig config_;
+    double scene_scale_ = 0.0;
+    int depth_ = 0;
+    std::vector<Grid> grids_;
+    std::vector<Cell> cells_;
+    std::vector<std::uint32_t> primitives_;
+    std::vector<std::uint32_t> unbounded_;
+    AcceleratorStats stats_;
+};
+
+class ShapeSet;
+template <class Real>
+class TriangleSet;
+extern template class HierarchicalGrid<TriangleSet<float>>;
+extern template class HierarchicalGrid<TriangleSet<double>>;
+extern template class HierarchicalGrid<ShapeSet>;
+
+}  // namespace csgrt

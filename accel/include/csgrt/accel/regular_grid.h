@@ -1,0 +1,141 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "csgrt/accel/accelerator.h"
+#include "csgrt/core/aabb.h"
+
+namespace csgrt {
+
+struct GridConfig {
+    /// Target number of cells per primitive (the grid density): the cell edge is
+    /// a = cbrt(V / (cells_per_primitive N)) for N primitives in a box of volume V, so the grid
+    /// has about cells_per_primitive N cells. The literature writes a = cbrt(lambda V / N), with
+    /// lambda = 1 / cells_per_primitive; Ize et al. 2007 show Theta(N) cells is right for
+    /// well-shaped meshes. Must be > 0.
+    double cells_per_primitive = 8.0;
+    /// Most cells along one axis (the clamp of the per-axis counts), >= 1. Keeps memory bounded
+    /// for very elongated or very large scenes.
+    int max_resolution = 256;
+    /// For triangle sets: reference a triangle only from the cells the triangle itself
+    /// overlaps (Akenine-Moeller, "Fast 3D Triangle-Box Overlap Testing", JGT 2001), not from
+    /// every cell of its bounding box. Long, thin, diagonal triangles touch far fewer cells.
+    bool triangle_box_test = true;
+};
+
+namespace detail {
+
+/// The cells of one uniform grid: a box cut into resolution[0] x resolution[1] x resolution[2]
+/// equal cells, numbered x fastest. Cell (i, j, k) spans lower + (i, j, k) * cell_size to
+/// lower + (i + 1, j + 1, k + 1) * cell_size; the traversal and the build use these same
+/// formulas, so they agree on every boundary.
+struct GridGeometry {
+    Aabb bounds;
+    std::array<int, 3> resolution{0, 0, 0};
+    Vector3 cell_size{0.0, 0.0, 0.0};
+    /// 1 / cell_size, or 0 on an axis with one cell of zero extent.
+    Vector3 inverse_cell_size{0.0, 0.0, 0.0};
+
+    std::size_t cell_count() const {
+        return std::size_t(resolution[0]) * std::size_t(resolution[1]) * std::size_t(resolution[2]);
+    }
+    std::size_t cell_index(int x, int y, int z) const {
+        return (std::size_t(z) * std::size_t(resolution[1]) + std::size_t(y)) *
+                   std::size_t(resolution[0]) +
+               std::size_t(x);
+    }
+    /// The cell coordinate of position p along `axis`, clamped into [0, resolution - 1] (so
+    /// points on or outside the faces belong to the outer cells; NaN gives 0).
+    int cell_coordinate(double p, int axis) const {
+        const double f = (p - bounds.lower[axis]) * inverse_cell_size[axis];
+        // Compared in double before converting, so out-of-range values never overflow the int.
+        if (!(f >= 1.0)) return 0;
+        if (f >= double(resolution[axis])) return resolution[axis] - 1;
+        return static_cast<int>(f);
+    }
+    Aabb cell_box(int x, int y, int z) const;
+};
+
+/// The geometry of a grid over `bounds` for `count` primitives: the cell edge a comes from
+/// the density heuristic over the axes of non-zero extent (a = (measure / cells)^(1/k) with k
+/// such axes), each such axis gets clamp(round(extent / a), 1, max_resolution) cells, a
+/// flat axis gets one. Axes that round to one cell are fixed at one and a is recomputed over
+/// the rest, so nearly flat scenes get the cells they should.
+GridGeometry choose_grid_geometry(const Aabb& bounds, std::size_t count, double cells_per_primitive,
+                                  int max_resolution);
+
+}  // namespace detail
+
+/// A uniform grid over a primitive set: the scene box cut into equal cells, each listing the
+/// primitives that overlap it, in compact (CSR) form: one offset per cell into one array of
+/// primitive indices. Rays walk the cells they cross in order with the 3D-DDA of Amanatides &
+/// Woo, "A Fast Voxel Traversal Algorithm for Ray Tracing", Eurographics 1987, and stop at the
+/// first cell that ends beyond the nearest hit found. A per-ray hashed mailbox on the stack
+/// skips most repeated tests of primitives that span several cells and keeps queries
+/// thread-safe. Primitives with unbounded or empty boxes are tested by every ray.
+template <class Set>
+class RegularGrid final : public Accelerator<Set> {
+public:
+    void build(const Set& set, const GridConfig& config = {});
+
+    std::string_view name() const override { return "grid"; }
+    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
+    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
+    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                           TraversalCounters& counters) const override;
+    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
+                          TraversalCounters& counters) const override;
+    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
+                  QueryScratch& scratch) const override;
+    AcceleratorStats stats() const override { return stats_; }
+
+    /// The grid's cells (box, resolution, cell size), for tests and reports.
+    const detail::GridGeometry& geometry() const { return geometry_; }
+    /// The primitives listed in cell (x, y, z), in ascending index order.
+    std::span<const std::uint32_t> cell_primitives(int x, int y, int z) const;
+    /// The Chebyshev distance, in cells and capped at 16, from cell (x, y, z) to the nearest
+    /// cell with primitives (0 for those): the walk jumps over the empty cells within that
+    /// distance minus one.
+    int empty_radius(int x, int y, int z) const {
+        return empty_radius_[geometry_.cell_index(x, y, z)];
+    }
+    /// Primitives every ray tests because their boxes are unbounded or empty.
+    std::span<const std::uint32_t> unbounded_primitives() const { return unbounded_; }
+
+private:
+    template <bool kCount>
+    bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                        TraversalCounters& counters) const;
+    template <bool kCount>
+    bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+    bool is_occupied(std::size_t cell) const { return (occupied_[cell / 64] >> (cell % 64)) & 1; }
+
+    const Set* set_ = nullptr;
+    detail::GridGeometry geometry_;
+    /// A scale of the scene's coordinates (largest |coordinate| plus largest extent), which the
+    /// stopping margin is relative to.
+    double scene_scale_ = 0.0;
+    /// Cell c lists primitives_[offsets_[c] .. offsets_[c + 1]).
+    std::vector<std::uint32_t> offsets_;
+    std::vector<std::uint32_t> primitives_;
+    /// One bit per cell, set when its list is not empty: most cells of a mesh's grid are
+    /// empty, and this 32 times smaller array stays in cache while the rays cross them.
+    std::vector<std::uint64_t> occupied_;
+    /// Per cell, the Chebyshev distance (in cells, capped at 16) to the nearest occupied
+    /// cell: the walk jumps over the empty cells around a cell in one step.
+    std::vector<std::uint8_t> empty_radius_;
+    std::vector<std::uint32_t> unbounded_;
+    AcceleratorStats stats_;
+};
+
+class ShapeSet;
+template <class Real>
+class TriangleSet;
+extern template class RegularGrid<TriangleSet<float>>;
+extern template class RegularGrid<TriangleSet<double>>;
+extern template class RegularGrid<ShapeSet>;
+
+}  // namespace csgrt

@@ -1,0 +1,146 @@
+#include <embree3/rtcore.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "peers.h"
+
+namespace csgrt::bench {
+
+namespace {
+
+/// Bytes the device holds, from Embree's memory monitor (called from its build threads).
+struct MemoryTally {
+    std::atomic<long long> current{0};
+};
+
+bool monitor(void* user, ssize_t bytes, bool /*post*/) {
+    static_cast<MemoryTally*>(user)->current.fetch_add(bytes, std::memory_order_relaxed);
+    return true;
+}
+
+void check(RTCDevice device, const char* step) {
+    const RTCError code = rtcGetDeviceError(device);
+    if (code != RTC_ERROR_NONE) {
+        throw std::runtime_error(std::string("Embree: ") + step + " failed with error " +
+                                 std::to_string(static_cast<int>(code)));
+    }
+}
+
+class EmbreeTracer final : public Tracer {
+public:
+    EmbreeTracer(const TriangleSet<float>& set, bool robust, int build_threads,
+                 EmbreeBuild* build) {
+        const std::string config = "threads=" + std::to_string(build_threads) + ",verbose=0";
+        device_ = rtcNewDevice(config.c_str());
+        if (device_ == nullptr) throw std::runtime_error("Embree: rtcNewDevice failed");
+        rtcSetDeviceMemoryMonitorFunction(device_, monitor, &memory_);
+
+        const auto start = std::chrono::steady_clock::now();
+        scene_ = rtcNewScene(device_);
+        if (robust) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+        RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+        const std::size_t count = set.size();
+        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * count));
+        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+            geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), count));
+        for (std::size_t i = 0; i < count; ++i) {
+            for (int k = 0; k < 3; ++k) {
+                const auto& corner = set.corner(i, k);
+                float* vertex = vertices + 9 * i + 3 * k;
+                vertex[0] = corner.x();
+                vertex[1] = corner.y();
+                vertex[2] = corner.z();
+                indices[3 * i + k] = static_cast<unsigned>(3 * i + k);
+            }
+        }
+        const long long buffers = memory_.current.load();
+        rtcCommitGeometry(geometry);
+        rtcAttachGeometry(scene_, geometry);
+        rtcReleaseGeometry(geometry);
+        rtcCommitScene(scene_);
+        check(device_, "building the scene");
+        if (build != nullptr) {
+            build->build_milliseconds =
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                    .count();
+            build->bytes = static_cast<std::size_t>(memory_.current.load());
+            build->buffer_bytes = static_cast<std::size_t>(buffers);
+        }
+    }
+    ~EmbreeTracer() override {
+        if (scene_ != nullptr) rtcReleaseScene(scene_);
+        rtcReleaseDevice(device_);
+    }
+    EmbreeTracer(const EmbreeTracer&) = delete;
+    EmbreeTracer& operator=(const EmbreeTracer&) = delete;
+
+    std::size_t nearest(std::span<const Ray> rays, QueryScratch&) const override {
+        std::size_t hits = 0;
+        for (const Ray& ray : rays) {
+            RTCIntersectContext context;
+            rtcInitIntersectContext(&context);
+            RTCRayHit query;
+            fill(ray, query.ray);
+            query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(scene_, &context, &query);
+            hits += query.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+        }
+        return hits;
+    }
+    std::size_t occluded(std::span<const Ray> rays, QueryScratch&) const override {
+        std::size_t hits = 0;
+        for (const Ray& ray : rays) {
+            RTCIntersectContext context;
+            rtcInitIntersectContext(&context);
+            RTCRay query;
+            fill(ray, query);
+            rtcOccluded1(scene_, &context, &query);
+            // Embree marks an occluded ray by setting tfar to -inf.
+            hits += query.tfar == -INFINITY ? 1 : 0;
+        }
+        return hits;
+    }
+
+private:
+    static void fill(const Ray& ray, RTCRay& query) {
+        query.org_x = static_cast<float>(ray.origin.x());
+        query.org_y = static_cast<float>(ray.origin.y());
+        query.org_z = static_cast<float>(ray.origin.z());
+        query.dir_x = static_cast<float>(ray.direction.x());
+        query.dir_y = static_cast<float>(ray.direction.y());
+        query.dir_z = static_cast<float>(ray.direction.z());
+        query.tnear = static_cast<float>(ray.t_min);
+        query.tfar = static_cast<float>(ray.t_max);
+        query.time = 0.0f;
+        query.mask = 0xffffffffu;
+        query.id = 0;
+        query.flags = 0;
+    }
+
+    RTCDevice device_ = nullptr;
+    RTCScene scene_ = nullptr;
+    MemoryTally memory_;
+};
+
+}  // namespace
+
+bool embree_available() {
+    return true;
+}
+
+std::string embree_version() {
+    return "Embree " RTC_VERSION_STRING;
+}
+
+std::unique_ptr<Tracer> make_embree_tracer(const TriangleSet<float>& set, bool robust,
+                                           int build_threads, EmbreeBuild* build) {
+    return std::make_unique<EmbreeTracer>(set, robust, build_threads, build);
+}
+
+}  // namespace csgrt::bench
