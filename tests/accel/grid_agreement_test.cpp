@@ -54,8 +54,8 @@ TYPED_TEST(GridAgreementTest, IntegerCube) {
 
 TYPED_TEST(GridAgreementTest, SphereMesh) {
     // 8,192 triangles: each brute-force answer is costly, so fewer rays here (the real meshes
-    // of grid_reference_test.cpp, up to 52,000 triangles, are compared with brute force on a
-    // sample of rays).
+    // of structure_reference_test.cpp, up to 52,000 triangles, are compared with brute force
+    // and CGAL there).
     EXPECT_EQ(this->expect_agreement_on(test::sphere_mesh(5), 3000, 3000, 102), 6300);
 }
 
