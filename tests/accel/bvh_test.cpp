@@ -12,6 +12,7 @@
 #include <tuple>
 #include <type_traits>
 
+#include "accel/grid_test_common.h"
 #include "csgrt/accel/brute_force.h"
 #include "csgrt/accel/factory.h"
 #include "csgrt/accel/triangle_set.h"
@@ -396,15 +397,12 @@ TEST(Bvh, EmptySetAndSinglePrimitive) {
     const TriangleSet<float> empty;
     Bvh<TriangleSet<float>> bvh;
     bvh.build(empty);
+    test::expect_empty_set_answers_nothing(bvh);
+    EXPECT_EQ(bvh.stats().primitives, 0u);
+
     QueryScratch scratch;
     HitRecord record;
     const Ray ray{Point3(0, 0, -1), Vector3(0, 0, 1)};
-    EXPECT_FALSE(bvh.intersect(ray, record, scratch));
-    EXPECT_FALSE(bvh.occluded(ray, scratch));
-    std::vector<HitRecord> hits;
-    bvh.all_hits(ray, hits, scratch);
-    EXPECT_TRUE(hits.empty());
-    EXPECT_EQ(bvh.stats().primitives, 0u);
 
     const std::vector<Eigen::Vector3d> vertices = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
     const std::vector<std::array<std::uint32_t, 3>> triangles = {{0, 1, 2}};

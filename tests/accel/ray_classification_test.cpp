@@ -9,6 +9,7 @@
 #include <thread>
 #include <tuple>
 
+#include "accel/grid_test_common.h"
 #include "csgrt/accel/brute_force.h"
 #include "csgrt/accel/factory.h"
 #include "csgrt/accel/triangle_set.h"
@@ -169,11 +170,8 @@ TYPED_TEST(RayClassificationTest, SameHitsAsBruteForceOnInCodeMeshes) {
         {"teapot in a stadium", teapot_in_stadium(), test::scaled(14000), test::scaled(2500)}};
     int total_rays = 0;
     for (const Case& c : cases) {
-        const TriangleSet<TypeParam> set(c.mesh.vertices, c.mesh.triangles);
-        BruteForce<TriangleSet<TypeParam>> brute;
-        brute.build(set);
-        RayClassification<TriangleSet<TypeParam>> structure;
-        structure.build(set);
+        const test::BuiltMesh<TypeParam, RayClassification> built(c.mesh);
+        const auto& [set, brute, structure] = built;
         const Aabb box = set_bounds(set);
         std::vector<Ray> rays = camera_rays(box, c.rays / 2, 100);
         const std::vector<Ray> incoherent = incoherent_rays(box, c.rays / 2, 200);
@@ -213,11 +211,8 @@ std::size_t expect_same_all_hits(const Accelerator<Set>& structure, const BruteF
 
 TYPED_TEST(RayClassificationTest, AllHitsEqualBruteForceAsASet) {
     const test::TestMesh mesh = test::sphere_mesh(4);
-    const TriangleSet<TypeParam> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(set);
-    RayClassification<TriangleSet<TypeParam>> structure;
-    structure.build(set);
+    const test::BuiltMesh<TypeParam, RayClassification> built(mesh);
+    const auto& [set, brute, structure] = built;
     const Aabb box = set_bounds(set);
     std::vector<Ray> rays = camera_rays(box, 3000, 300);
     const std::vector<Ray> incoherent = incoherent_rays(box, 3000, 301);
@@ -231,11 +226,8 @@ TYPED_TEST(RayClassificationTest, TiedDominantAxesAndFaceBoundaries) {
     // face coordinates are exactly u = +-1 or v = +-1 (on the boundary between two faces), or
     // exactly 0 (along an axis).
     const test::TestMesh mesh = test::integer_cube(6);
-    const TriangleSet<TypeParam> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(set);
-    RayClassification<TriangleSet<TypeParam>> structure;
-    structure.build(set);
+    const test::BuiltMesh<TypeParam, RayClassification> built(mesh);
+    const auto& [set, brute, structure] = built;
     test::Random random(400);
     std::vector<Vector3> directions;
     for (int x = -1; x <= 1; ++x)
@@ -269,11 +261,8 @@ TYPED_TEST(RayClassificationTest, RaysStartingInsideAndInsideTheMesh) {
     // Origins inside the scene box and inside the closed mesh: every ray must hit, and the
     // classified point is the origin itself, not an entry point.
     const test::TestMesh mesh = test::sphere_mesh(4);
-    const TriangleSet<TypeParam> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(set);
-    RayClassification<TriangleSet<TypeParam>> structure;
-    structure.build(set);
+    const test::BuiltMesh<TypeParam, RayClassification> built(mesh);
+    const auto& [set, brute, structure] = built;
     test::Random random(500);
     std::vector<Ray> rays;
     for (int i = 0; i < 10000; ++i)
@@ -283,36 +272,13 @@ TYPED_TEST(RayClassificationTest, RaysStartingInsideAndInsideTheMesh) {
 }
 
 TYPED_TEST(RayClassificationTest, InvalidRaysHitNothingAndDoNotHang) {
-    const test::TestMesh mesh = test::integer_cube(2);
-    const TriangleSet<TypeParam> set(mesh.vertices, mesh.triangles);
-    RayClassification<TriangleSet<TypeParam>> structure;
-    structure.build(set);
+    const test::BuiltMesh<TypeParam, RayClassification> built(test::integer_cube(2));
+    test::expect_invalid_rays_answer_nothing(built.structure);
+    // The same ray made valid does hit: the rejections are about validity.
     QueryScratch scratch;
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    const std::vector<Ray> rays = {
-        Ray{Point3(1, 1, -5), Vector3(0, 0, 0)},
-        Ray{Point3(1, 1, -5), Vector3(nan, 0, 1)},
-        Ray{Point3(nan, 1, -5), Vector3(0, 0, 1)},
-        Ray{Point3(1, 1, -5), Vector3(0, kInfinity, 1)},
-        Ray{Point3(-kInfinity, 1, 1), Vector3(1, 0, 0)},
-        Ray{Point3(1, 1, -5), Vector3(0, 0, 1), 3.0, 2.0},
-        Ray{Point3(1, 1, -5), Vector3(0, 0, 1), nan, 9.0},
-        Ray{Point3(1, 1, -5), Vector3(0, 0, 1), 0.0, nan},
-    };
-    for (const Ray& ray : rays) {
-        HitRecord record;
-        EXPECT_FALSE(structure.intersect(ray, record, scratch));
-        EXPECT_FALSE(structure.occluded(ray, scratch));
-        TraversalCounters counters;
-        EXPECT_FALSE(structure.intersect_counted(ray, record, scratch, counters));
-        EXPECT_FALSE(structure.occluded_counted(ray, scratch, counters));
-        std::vector<HitRecord> hits;
-        structure.all_hits(ray, hits, scratch);
-        EXPECT_TRUE(hits.empty());
-    }
-    // The same ray made valid does hit: the rejections above are about validity.
     HitRecord record;
-    EXPECT_TRUE(structure.intersect(Ray{Point3(1, 1, -5), Vector3(0, 0, 1)}, record, scratch));
+    EXPECT_TRUE(
+        built.structure.intersect(Ray{Point3(1, 1, -5), Vector3(0, 0, 1)}, record, scratch));
     EXPECT_EQ(record.t, 5.0);
 }
 
@@ -320,52 +286,26 @@ TYPED_TEST(RayClassificationTest, EmptySetAndOnePrimitive) {
     const TriangleSet<TypeParam> empty;
     RayClassification<TriangleSet<TypeParam>> none;
     none.build(empty);
-    QueryScratch scratch;
-    HitRecord record;
-    const Ray ray{Point3(0.2, 0.2, -1), Vector3(0, 0, 1)};
-    EXPECT_FALSE(none.intersect(ray, record, scratch));
-    EXPECT_FALSE(none.occluded(ray, scratch));
+    test::expect_empty_set_answers_nothing(none);
     EXPECT_EQ(none.stats().primitives, 0u);
-
-    const std::vector<Eigen::Vector3d> vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-    const std::vector<std::array<std::uint32_t, 3>> triangles = {{0, 1, 2}};
-    const TriangleSet<TypeParam> one(vertices, triangles);
-    RayClassification<TriangleSet<TypeParam>> single;
-    single.build(one);
-    ASSERT_TRUE(single.intersect(ray, record, scratch));
-    EXPECT_EQ(record.t, 1.0);
-    EXPECT_EQ(record.primitive, 0u);
-    EXPECT_FALSE(single.intersect(Ray{Point3(0.7, 0.7, -1), Vector3(0, 0, 1)}, record, scratch));
-    // The interval is closed at both ends and honoured at both.
-    EXPECT_TRUE(single.occluded(Ray{ray.origin, ray.direction, 0.0, 1.0}, scratch));
-    EXPECT_TRUE(single.occluded(Ray{ray.origin, ray.direction, 1.0, 2.0}, scratch));
-    EXPECT_FALSE(single.occluded(Ray{ray.origin, ray.direction, 0.0, 0.999}, scratch));
-    EXPECT_FALSE(single.occluded(Ray{ray.origin, ray.direction, 1.001, 2.0}, scratch));
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(one);
-    expect_same_as_brute_force(single, brute, incoherent_rays(set_bounds(one), 5000, 600),
+    const test::TestMesh triangle = test::single_triangle();
+    const test::BuiltMesh<TypeParam, RayClassification> one(triangle);
+    test::expect_single_triangle_answers(one.structure);
+    expect_same_as_brute_force(one.structure, one.brute,
+                               incoherent_rays(test::mesh_bounds(triangle), 5000, 600),
                                "one triangle");
 }
 
 TYPED_TEST(RayClassificationTest, IdenticalTrianglesStayInOneLongLeaf) {
     // Forty copies of one triangle: no cell's list ever drops to the leaf size, so splitting
     // stops at max_depth; ties go to the lowest index whatever cell a ray lands in.
-    std::vector<Eigen::Vector3d> vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5}};
-    std::vector<std::array<std::uint32_t, 3>> triangles(40, {0, 1, 2});
-    const TriangleSet<TypeParam> set(vertices, triangles);
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(set);
-    RayClassification<TriangleSet<TypeParam>> structure;
-    RayClassificationConfig config;
-    config.max_depth = 12;
-    structure.build(set, config);
-    const std::vector<Ray> rays = camera_rays(set_bounds(set), 20000, 700);
-    const int hits = expect_same_as_brute_force(structure, brute, rays, "identical");
+    const test::TestMesh copies = test::identical_triangles(40);
+    const test::BuiltMesh<TypeParam, RayClassification> built(
+        copies, RayClassificationConfig{.max_depth = 12});
+    const std::vector<Ray> rays = camera_rays(test::mesh_bounds(copies), 20000, 700);
+    const int hits = expect_same_as_brute_force(built.structure, built.brute, rays, "identical");
     EXPECT_GT(hits, 5000);
-    QueryScratch scratch;
-    HitRecord record;
-    ASSERT_TRUE(structure.intersect(Ray{Point3(0.2, 0.2, -3), Vector3(0, 0, 1)}, record, scratch));
-    EXPECT_EQ(record.primitive, 0u);
+    test::expect_identical_copies_each_once(built.structure, 40);
 }
 
 TYPED_TEST(RayClassificationTest, FlatBoundsWithParallelAndGrazingRays) {
@@ -380,11 +320,8 @@ TYPED_TEST(RayClassificationTest, FlatBoundsWithParallelAndGrazingRays) {
         mesh.vertices.insert(mesh.vertices.end(), {a, b, c});
         mesh.triangles.push_back({index, index + 1, index + 2});
     }
-    const TriangleSet<TypeParam> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(set);
-    RayClassification<TriangleSet<TypeParam>> structure;
-    structure.build(set);
+    const test::BuiltMesh<TypeParam, RayClassification> built(mesh);
+    const auto& [set, brute, structure] = built;
     std::vector<Ray> rays;
     for (int i = 0; i < 20000; ++i) {
         Ray ray;
@@ -415,11 +352,8 @@ TYPED_TEST(RayClassificationTest, FarAwayOriginsStillExact) {
     // Origins hundreds to millions of scene sizes away: beyond what the padding covers for the
     // float set's rounding, so those rays search every primitive; answers stay exact.
     const test::TestMesh mesh = test::sphere_mesh(3);
-    const TriangleSet<TypeParam> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(set);
-    RayClassification<TriangleSet<TypeParam>> structure;
-    structure.build(set);
+    const test::BuiltMesh<TypeParam, RayClassification> built(mesh);
+    const auto& [set, brute, structure] = built;
     test::Random random(900);
     std::vector<Ray> rays;
     for (int i = 0; i < 6000; ++i) {
@@ -486,11 +420,8 @@ TEST(RayClassification, PrebuildAndBuildDepthGiveTheSameAnswers) {
 
 TEST(RayClassification, CountedQueriesTestFewPrimitives) {
     const test::TestMesh mesh = test::sphere_mesh(5);
-    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<float>> brute;
-    brute.build(set);
-    RayClassification<TriangleSet<float>> structure;
-    structure.build(set);
+    const test::BuiltMesh<float, RayClassification> built(mesh);
+    const auto& [set, brute, structure] = built;
     const std::vector<Ray> rays = camera_rays(set_bounds(set), 8000, 1200);
     QueryScratch scratch;
     TraversalCounters brute_counts, counts;

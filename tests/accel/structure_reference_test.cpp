@@ -32,6 +32,7 @@
 #include "support/real_meshes.h"
 #include "support/reference_check.h"
 #include "support/test_scale.h"
+#include "support/unbounded_plane.h"
 
 namespace csgrt {
 namespace {
@@ -172,25 +173,6 @@ INSTANTIATE_TEST_SUITE_P(RealMeshes, StructuresAgainstCgal, ::testing::ValuesIn(
                              return name;
                          });
 
-/// The plane z = 0 as an unbounded shape (infinite bounds): structures keep it out of their
-/// cells and nodes and test it for every ray.
-class UnboundedPlane final : public Shape {
-public:
-    std::string_view kind() const override { return "unbounded_plane"; }
-    Aabb bounds() const override { return Aabb::infinite(); }
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const override {
-        if (ray.direction.z() == 0.0) return false;
-        const double t = -ray.origin.z() / ray.direction.z();
-        if (!ray.in_range(t)) return false;
-        record = HitRecord{.t = t, .shape = this, .primitive = 0};
-        return true;
-    }
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override {
-        HitRecord record;
-        return nearest_hit(ray, record, scratch);
-    }
-};
-
 TEST(StructuresAgainstBruteForce, TenThousandSpheresAndAnUnboundedPlane) {
     // A list of 10,001 shapes: spheres of radius 0.02 to 0.4 (some overlapping) above an
     // unbounded plane. Brute force, which calls every shape, answers each ray once; the other
@@ -205,7 +187,7 @@ TEST(StructuresAgainstBruteForce, TenThousandSpheresAndAnUnboundedPlane) {
     for (int i = 0; i < kSpheres; ++i)
         shapes.push_back(
             std::make_shared<Sphere>(random.in_box(region), random.uniform(0.02, 0.4)));
-    shapes.push_back(std::make_shared<UnboundedPlane>());
+    shapes.push_back(std::make_shared<test::UnboundedPlane>());
     const ShapeSet set(shapes);
     BruteForce<ShapeSet> brute;
     brute.build(set);

@@ -46,33 +46,39 @@ inline void random_interval(Random& random, Ray& ray) {
     }
 }
 
-/// Camera-like rays: from points on a shell around `box` (1 to 2 box sizes out) toward random
-/// points of the box.
-inline std::vector<Ray> camera_rays(const Aabb& box, int count, std::uint64_t seed) {
+/// `count` rays, the i-th made by `make(random, i)` from one seeded Random, every fourth then
+/// given a random interval (random_interval).
+template <class Make>
+std::vector<Ray> seeded_rays(int count, std::uint64_t seed, Make&& make) {
     Random random(seed);
     std::vector<Ray> rays;
-    const double size = box.diagonal().norm();
+    rays.reserve(static_cast<std::size_t>(count));
     for (int i = 0; i < count; ++i) {
-        const Point3 eye = box.center() + random.unit_vector() * size * random.uniform(1.0, 2.0);
-        const Point3 target = random.in_box(box);
-        rays.push_back(Ray{eye, (target - eye) * random.uniform(0.25, 4.0) / size});
+        rays.push_back(make(random, i));
         if (i % 4 == 0) random_interval(random, rays.back());
     }
     return rays;
 }
 
+/// Camera-like rays: from points on a shell around `box` (1 to 2 box sizes out) toward random
+/// points of the box.
+inline std::vector<Ray> camera_rays(const Aabb& box, int count, std::uint64_t seed) {
+    const double size = box.diagonal().norm();
+    return seeded_rays(count, seed, [&](Random& random, int) {
+        const Point3 eye = box.center() + random.unit_vector() * size * random.uniform(1.0, 2.0);
+        const Point3 target = random.in_box(box);
+        return Ray{eye, (target - eye) * random.uniform(0.25, 4.0) / size};
+    });
+}
+
 /// Incoherent rays: random origins in and around `box` (half of them inside), random
 /// directions of random length.
 inline std::vector<Ray> incoherent_rays(const Aabb& box, int count, std::uint64_t seed) {
-    Random random(seed);
-    std::vector<Ray> rays;
     const Aabb around = enlarged(box, 0.5);
-    for (int i = 0; i < count; ++i) {
+    return seeded_rays(count, seed, [&](Random& random, int i) {
         const Point3 origin = random.in_box(i % 2 ? box : around);
-        rays.push_back(Ray{origin, random.unit_vector() * random.uniform(0.25, 4.0)});
-        if (i % 4 == 0) random_interval(random, rays.back());
-    }
-    return rays;
+        return Ray{origin, random.unit_vector() * random.uniform(0.25, 4.0)};
+    });
 }
 
 /// Rays parallel to the axes (exact zero components), from random points in and around `box`.
