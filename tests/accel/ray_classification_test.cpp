@@ -179,8 +179,9 @@ TYPED_TEST(RayClassificationTest, SameHitsAsBruteForceOnInCodeMeshes) {
         const int hits = expect_same_as_brute_force(structure, brute, rays, c.name);
         total_rays += static_cast<int>(rays.size());
         EXPECT_GT(hits, c.minimum_hits) << c.name;
-        // The lazy build did happen: far more cells than the six roots.
-        EXPECT_GT(structure.stats().nodes, 100u) << c.name;
+        // The lazy build did happen: far more cells than the six roots (at an eighth of the
+        // rays, under the sanitizers, measured 16 to 58 cells: still more than the roots).
+        EXPECT_GT(structure.stats().nodes, test::reduced_scale() ? 6u : 100u) << c.name;
     }
     EXPECT_GE(total_rays, test::scaled(100000));
 }
