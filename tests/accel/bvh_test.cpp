@@ -272,7 +272,8 @@ TEST(Bvh, TriangleBlocksGiveTheScalarTestsBitsOnEdgeAndVertexRays) {
     // t, u or v. Whole lines report every triangle they cross, so all_hits compares the two
     // tests on every triangle the line meets. Rays aimed exactly at shared vertices and at
     // points of shared edges make the edge functions zero or tiny: the double-precision
-    // recomputation and the sign rules are exercised there. A million rays.
+    // recomputation and the sign rules are exercised there. A million rays (label "heavy":
+    // test::scaled() of them under the sanitizers).
     TestMesh fan;
     fan.vertices.emplace_back(0.0, 0.0, 0.0);
     for (int k = 0; k < 12; ++k) {
@@ -292,7 +293,7 @@ TEST(Bvh, TriangleBlocksGiveTheScalarTestsBitsOnEdgeAndVertexRays) {
         {"fan", fan},
         {"soup at 2^-64", tiny}};
     test::Random random(17);
-    const int rays_per_mesh = 250000;
+    const int rays_per_mesh = test::scaled(250000);
     for (const auto& [name, mesh] : meshes) {
         const TriangleSet<float> set(mesh.vertices, mesh.triangles);
         BruteForce<TriangleSet<float>> brute;
