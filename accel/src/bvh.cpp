@@ -418,7 +418,7 @@ struct BvhTraversal {
     /// indices.
     template <int kWidth>
     static void prefetch([[maybe_unused]] const Tree& bvh,
-                         [[maybe_unused]] const std::vector<WideBvhNode<kWidth>>& nodes,
+                         [[maybe_unused]] const WideBvhNodes<kWidth>& nodes,
                          [[maybe_unused]] std::uint32_t first,
                          [[maybe_unused]] std::uint32_t count) {
 #if defined(__SSE2__)
@@ -490,7 +490,7 @@ struct BvhTraversal {
     }
 
     template <bool kCount, bool kSigned, class NodeTest, int kWidth, class Leaf>
-    static void traverse_wide(const Tree& bvh, const std::vector<WideBvhNode<kWidth>>& nodes,
+    static void traverse_wide(const Tree& bvh, const WideBvhNodes<kWidth>& nodes,
                               const BoxRay& box_ray, double ray_t_max, TraversalCounters& counters,
                               Leaf& leaf) {
         using Node = WideBvhNode<kWidth>;
@@ -780,17 +780,20 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     nodes_8_.clear();
     binary_nodes_.clear();
     if (config.width == 4) {
-        nodes_4_ = detail::collapse_to_wide<4>(tree);
+        nodes_4_ = detail::collapse_to_wide<4>(tree, config.parallel);
     } else if (config.width == 8) {
-        nodes_8_ = detail::collapse_to_wide<8>(tree);
+        nodes_8_ = detail::collapse_to_wide<8>(tree, config.parallel);
     } else {
         binary_nodes_ = std::move(tree.nodes);
+        binary_nodes_.shrink_to_fit();
     }
 
     stats_ = AcceleratorStats{};
     stats_.name = "bvh";
-    stats_.bytes = binary_nodes_.capacity() * sizeof(BvhNode) +
-                   nodes_4_.capacity() * sizeof(Bvh4Node) + nodes_8_.capacity() * sizeof(Bvh8Node) +
+    // The wide nodes are counted by size: collapse_to_wide reserves more address space than it
+    // uses, and the pages it never writes are never mapped.
+    stats_.bytes = binary_nodes_.capacity() * sizeof(BvhNode) + nodes_4_.size() * sizeof(Bvh4Node) +
+                   nodes_8_.size() * sizeof(Bvh8Node) +
                    indices_.capacity() * sizeof(std::uint32_t) +
                    blocks_.capacity() * sizeof(BvhTriangleBlock);
     stats_.nodes = nodes_4_.size() + nodes_8_.size() + binary_nodes_.size();

@@ -1,4 +1,6 @@
+#include <sys/mman.h>
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
@@ -18,13 +20,32 @@ namespace csgrt::detail {
 
 namespace {
 
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+
+/// Whether a block is large enough to be worth huge pages (two of them at least, so the
+/// rounding waste stays small). Not under AddressSanitizer, whose allocator would be handed
+/// an alignment it does not need and whose pages are its own business.
+bool use_huge_pages(std::size_t bytes) {
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define CSGRT_ADDRESS_SANITIZER 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(CSGRT_ADDRESS_SANITIZER)
+    (void)bytes;
+    return false;
+#else
+    return bytes >= 2 * kHugePage;
+#endif
+}
+
 constexpr float kInfinityFloat = std::numeric_limits<float>::infinity();
 constexpr int kMaxBins = 256;
 /// Below this size a subtree is built on one thread: smaller tasks cost more to schedule than
 /// they save.
 constexpr std::uint32_t kParallelSubtree = 4096;
 /// Nodes larger than this find their split on a sample of their primitives.
-constexpr std::uint32_t kSampledBinning = 1u << 14;
+constexpr std::uint32_t kSampledBinning = 1u << 12;
 
 /// A float box in two SIMD registers (the fourth lane is unused).
 struct Box {
@@ -128,15 +149,15 @@ struct BinMapping {
 
 struct Bins {
     Box boxes[3][kMaxBins];
-    std::uint32_t counts[3][kMaxBins];
+    /// counts[bin][axis], as floats so the sweep loads a bin's three counts as one Float4;
+    /// whole numbers below 2^24 (at most kSampledBinning primitives are binned), so exact.
+    alignas(16) float counts[kMaxBins][4];
     int bin_count;
 
     /// Only the first `bin_count` bins of each axis are used (and initialised).
     explicit Bins(int n) : bin_count(n) {
-        for (int axis = 0; axis < 3; ++axis) {
-            std::fill_n(boxes[axis], n, Box::empty());
-            std::fill_n(counts[axis], n, 0u);
-        }
+        for (int axis = 0; axis < 3; ++axis) std::fill_n(boxes[axis], n, Box::empty());
+        std::fill_n(&counts[0][0], 4 * n, 0.0f);
     }
     void add(const BinMapping& mapping, const BuildPrimitive& primitive) {
         alignas(16) int bin[4];
@@ -144,7 +165,7 @@ struct Bins {
         const Box box = Box::of(primitive);
         for (int axis = 0; axis < 3; ++axis) {
             boxes[axis][bin[axis]].extend(box);
-            ++counts[axis][bin[axis]];
+            counts[bin[axis]][axis] += 1.0f;
         }
     }
 };
@@ -156,6 +177,13 @@ struct Split {
     /// Sum over both sides of half area times primitive tests (relative to the node's half
     /// area once find_split returns it).
     float cost = std::numeric_limits<float>::infinity();
+};
+
+/// What a subtree's build returns: its depth and its unnormalised SAH cost (the sum over
+/// its nodes of half area times the node's cost).
+struct Subtree {
+    int depth = 0;
+    double cost = 0.0;
 };
 
 class Builder {
@@ -197,7 +225,8 @@ public:
     }
 
     /// Builds the subtree of `range` into node `node`; returns its depth.
-    int build(std::uint32_t node, const Range& range, int depth) {
+    /// Builds the subtree of `range` at node `node`; returns its depth and SAH cost.
+    Subtree build(std::uint32_t node, const Range& range, int depth) {
         const std::uint32_t count = range.end - range.begin;
         BvhNode& target = nodes_[node];
         range.box.store(target.lower, target.upper);
@@ -244,21 +273,23 @@ public:
             target.offset = range.begin;
             target.count = count;
             leaves_.fetch_add(1, std::memory_order_relaxed);
-            return 0;
+            return {0, range.box.half_area() * config_.intersection_cost * tests(count)};
         }
 
         const std::uint32_t first = next_node_.fetch_add(2, std::memory_order_relaxed);
         target.offset = first;
         target.count = 0;
-        int left_depth = 0, right_depth = 0;
+        Subtree left_tree, right_tree;
         if (config_.parallel && count > kParallelSubtree) {
-            tbb::parallel_invoke([&] { left_depth = build(first, left, depth + 1); },
-                                 [&] { right_depth = build(first + 1, right, depth + 1); });
+            tbb::parallel_invoke([&] { left_tree = build(first, left, depth + 1); },
+                                 [&] { right_tree = build(first + 1, right, depth + 1); });
         } else {
-            left_depth = build(first, left, depth + 1);
-            right_depth = build(first + 1, right, depth + 1);
+            left_tree = build(first, left, depth + 1);
+            right_tree = build(first + 1, right, depth + 1);
         }
-        return 1 + std::max(left_depth, right_depth);
+        // Summed in the same order whatever the threads did, so the cost is reproducible.
+        return {1 + std::max(left_tree.depth, right_tree.depth),
+                range.box.half_area() * config_.traversal_cost + left_tree.cost + right_tree.cost};
     }
 
     std::uint32_t node_count() const { return next_node_.load(); }
@@ -305,30 +336,54 @@ private:
         const Float4 scale = Float4::broadcast(std::ldexp(1.0f, std::clamp(-exponent, -126, 126)));
         const float node_area = range.box.scaled_half_area(scale);
 
+        // The three axes are swept at once, lane a of each Float4 below for axis a: the cost
+        // of splitting after bin b is area(left) tests(left) + area(right) tests(right), +inf
+        // when a side is empty.
+        const Float4 infinity = Float4::broadcast(kInfinityFloat);
+        const Float4 zero = Float4::broadcast(0.0f);
+        // A leaf of n costs ceil(n / block) tests, computed as trunc((n + block - 1) / block):
+        // the counts are integers well inside float's exact range.
+        const float block = float(1u << leaf_block_shift_);
+        const Float4 round_up = Float4::broadcast(block - 1.0f);
+        const Float4 per_block = Float4::broadcast(1.0f / block);
+        auto side_cost = [&](const Box sides[3], Float4 counts) {
+            Float4 x, y, z;
+            transpose3((sides[0].upper - sides[0].lower) * scale,
+                       (sides[1].upper - sides[1].lower) * scale,
+                       (sides[2].upper - sides[2].lower) * scale, x, y, z);
+            const Float4 area = x * y + y * z + z * x;
+            const Float4 cost = area * ((counts + round_up) * per_block).truncated();
+            const Float4 filled = zero < counts;
+            return (filled & cost) | and_not(filled, infinity);
+        };
+        auto counts_at = [&](int b) { return Float4::load_aligned(bins.counts[b]); };
+        Float4 right_cost[kMaxBins];
+        Box right[3] = {Box::empty(), Box::empty(), Box::empty()};
+        Float4 right_count = zero;
+        for (int b = bin_count - 1; b > 0; --b) {
+            for (int axis = 0; axis < 3; ++axis) right[axis].extend(bins.boxes[axis][b]);
+            right_count = right_count + counts_at(b);
+            right_cost[b] = side_cost(right, right_count);
+        }
+        Box left[3] = {Box::empty(), Box::empty(), Box::empty()};
+        Float4 left_count = zero;
+        Float4 best_cost = infinity, best_bin = zero;
+        for (int b = 0; b < bin_count - 1; ++b) {
+            for (int axis = 0; axis < 3; ++axis) left[axis].extend(bins.boxes[axis][b]);
+            left_count = left_count + counts_at(b);
+            const Float4 cost = side_cost(left, left_count) + right_cost[b + 1];
+            // Strictly less: ties keep the lowest bin, as do ties between axes below.
+            const Float4 better = cost < best_cost;
+            best_cost = min(cost, best_cost);
+            best_bin = (better & Float4::broadcast(float(b))) | and_not(better, best_bin);
+        }
+        float costs[4], bins_found[4];
+        best_cost.store(costs);
+        best_bin.store(bins_found);
         Split best;
-        float right_cost[kMaxBins];
         for (int axis = 0; axis < 3; ++axis) {
-            if (mapping.scales[axis] == 0.0f) continue;
-            // Sweep from the right, then from the left: the cost of splitting after bin b is
-            // area(left) tests(left) + area(right) tests(right).
-            Box right = Box::empty();
-            std::uint32_t right_count = 0;
-            for (int b = bin_count - 1; b > 0; --b) {
-                right.extend(bins.boxes[axis][b]);
-                right_count += bins.counts[axis][b];
-                right_cost[b] =
-                    right_count ? right.scaled_half_area(scale) * float(tests(right_count)) : -1.0f;
-            }
-            Box left = Box::empty();
-            std::uint32_t left_count = 0;
-            for (int b = 0; b < bin_count - 1; ++b) {
-                left.extend(bins.boxes[axis][b]);
-                left_count += bins.counts[axis][b];
-                if (left_count == 0 || right_cost[b + 1] < 0.0f) continue;
-                const float cost =
-                    left.scaled_half_area(scale) * float(tests(left_count)) + right_cost[b + 1];
-                if (cost < best.cost) best = Split{axis, b, cost};
-            }
+            if (mapping.scales[axis] != 0.0f && costs[axis] < best.cost)
+                best = Split{axis, int(bins_found[axis]), costs[axis]};
         }
         // Relative to the node's area, as the SAH wants it.
         if (best.axis >= 0) best.cost = node_area > 0.0f ? best.cost / node_area : 0.0f;
@@ -412,125 +467,174 @@ private:
     std::atomic<std::size_t> leaves_{0};
 };
 
-double node_half_area(const BvhNode& node) {
-    const float lower[4] = {node.lower[0], node.lower[1], node.lower[2], 0.0f};
-    const float upper[4] = {node.upper[0], node.upper[1], node.upper[2], 0.0f};
-    return Box{Float4::load(lower), Float4::load(upper)}.half_area();
+/// Half the surface area of a binary node's box in float: collapse_node only compares the
+/// areas of siblings and cousins, for which float is ample (ties go to the first child).
+float node_half_area_float(const BvhNode& node) {
+    const float x = node.upper[0] - node.lower[0], y = node.upper[1] - node.lower[1],
+                z = node.upper[2] - node.lower[2];
+    return x * y + y * z + z * x;
 }
 
-double sah_cost(const BinaryBvh& tree, const BvhConfig& config, int leaf_block) {
-    auto half_area = [](const BvhNode& node) { return node_half_area(node); };
-    double total = 0.0;
-    for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
-        if (i == 1) continue;
-        const BvhNode& node = tree.nodes[i];
-        const std::uint32_t tests = (node.count + leaf_block - 1) / leaf_block;
-        total += half_area(node) *
-                 (node.is_leaf() ? config.intersection_cost * tests : config.traversal_cost);
-    }
-    const double root_area = half_area(tree.nodes[0]);
-    return root_area > 0.0 ? total / root_area : 0.0;
-}
-
-/// Appends the wide node that replaces binary node `index` and, depth first, its subtree;
-/// returns the new node's index.
+/// Collapses a binary tree into wide nodes, depth first from the root, the top levels in
+/// parallel (see collapse_to_wide).
 template <int kWidth>
-std::uint32_t collapse_node(const BinaryBvh& binary, std::uint32_t index,
-                            std::vector<WideBvhNode<kWidth>>& wide) {
+class Collapser {
+public:
     using Node = WideBvhNode<kWidth>;
-    const auto& nodes = binary.nodes;
-    std::array<std::uint32_t, kWidth> children{};
-    int child_count = 0;
-    if (nodes[index].is_leaf()) {
-        children[child_count++] = index;  // a lone leaf at the root
-    } else {
-        children[child_count++] = nodes[index].offset;
-        children[child_count++] = nodes[index].offset + 1;
-    }
-    // Open the interior child with the largest box until there are kWidth: it is the one a
-    // random ray is most likely to enter, so adopting its children saves the most visits.
-    while (child_count < kWidth) {
-        int widest = -1;
-        double widest_area = -1.0;
-        for (int i = 0; i < child_count; ++i) {
-            const BvhNode& child = nodes[children[i]];
-            if (child.is_leaf()) continue;
-            const double area = node_half_area(child);
-            if (area > widest_area) widest_area = area, widest = i;
+
+    Collapser(const BinaryBvh& binary, Node* wide, bool parallel)
+        : nodes_(binary.nodes.data()), wide_(wide), parallel_(parallel) {}
+
+    /// Writes into wide[wide_index] the wide node that replaces binary node `index`, then
+    /// its subtree.
+    void collapse(std::uint32_t index, std::uint32_t wide_index, int depth) {
+        std::uint32_t children[kWidth];
+        float areas[kWidth];
+        int child_count = 0;
+        // Leaves are never opened: they get area -1.
+        auto area = [&](std::uint32_t child) {
+            return nodes_[child].is_leaf() ? -1.0f : node_half_area_float(nodes_[child]);
+        };
+        auto adopt = [&](std::uint32_t child) {
+            children[child_count] = child;
+            areas[child_count++] = area(child);
+        };
+        if (nodes_[index].is_leaf()) {
+            adopt(index);  // a lone leaf at the root
+        } else {
+            adopt(nodes_[index].offset);
+            adopt(nodes_[index].offset + 1);
         }
-        if (widest < 0) break;
-        const std::uint32_t opened = children[widest];
-        children[widest] = nodes[opened].offset;
-        children[child_count++] = nodes[opened].offset + 1;
+        // Open the interior child with the largest box until there are kWidth: it is the one
+        // a random ray is most likely to enter, so adopting its children saves the most visits.
+        while (child_count < kWidth) {
+            int widest = 0;
+            for (int i = 1; i < child_count; ++i) {
+                if (areas[i] > areas[widest]) widest = i;
+            }
+            if (areas[widest] < 0.0f) break;
+            // The opened node's left child takes its slot, its right child the next free one.
+            const std::uint32_t opened = nodes_[children[widest]].offset;
+            children[widest] = opened;
+            areas[widest] = area(opened);
+            adopt(opened + 1);
+        }
+
+        int interior = 0;
+        for (int slot = 0; slot < child_count; ++slot)
+            interior += !nodes_[children[slot]].is_leaf();
+        // A node's interior children are allocated side by side.
+        const std::uint32_t first_child =
+            interior ? next_.fetch_add(std::uint32_t(interior), std::memory_order_relaxed) : 0u;
+        Node& node = wide_[wide_index];
+        std::uint32_t next_child = first_child;
+        for (int slot = 0; slot < kWidth; ++slot) {
+            if (slot >= child_count) {
+                for (int axis = 0; axis < 3; ++axis) {
+                    node.bounds[2 * axis][slot] = kInfinityFloat;
+                    node.bounds[2 * axis + 1][slot] = -kInfinityFloat;
+                }
+                node.first[slot] = 0;
+                node.count[slot] = 0;
+                continue;
+            }
+            const BvhNode& child = nodes_[children[slot]];
+            for (int axis = 0; axis < 3; ++axis) {
+                node.bounds[2 * axis][slot] = child.lower[axis];
+                node.bounds[2 * axis + 1][slot] = child.upper[axis];
+            }
+            if (child.is_leaf()) {
+                node.first[slot] = child.offset;
+                node.count[slot] = child.count;
+            } else {
+                node.first[slot] = next_child++;
+                node.count[slot] = Node::kInterior;
+            }
+        }
+
+        // The top levels (up to kWidth^3 subtrees) are collapsed as parallel tasks.
+        auto descend = [&](int slot) {
+            if (slot < child_count && node.count[slot] == Node::kInterior)
+                collapse(children[slot], node.first[slot], depth + 1);
+        };
+        if (parallel_ && depth < 3 && interior > 1) {
+            tbb::parallel_for(0, kWidth, descend);
+        } else {
+            for (int slot = 0; slot < kWidth; ++slot) descend(slot);
+        }
     }
 
-    const auto wide_index = static_cast<std::uint32_t>(wide.size());
-    wide.emplace_back();
-    for (int slot = 0; slot < kWidth; ++slot) {
-        Node& node = wide[wide_index];
-        if (slot >= child_count) {
-            for (int axis = 0; axis < 3; ++axis) {
-                node.bounds[2 * axis][slot] = kInfinityFloat;
-                node.bounds[2 * axis + 1][slot] = -kInfinityFloat;
-            }
-            node.first[slot] = 0;
-            node.count[slot] = 0;
-            continue;
-        }
-        const BvhNode& child = nodes[children[slot]];
-        for (int axis = 0; axis < 3; ++axis) {
-            node.bounds[2 * axis][slot] = child.lower[axis];
-            node.bounds[2 * axis + 1][slot] = child.upper[axis];
-        }
-        if (child.is_leaf()) {
-            node.first[slot] = child.offset;
-            node.count[slot] = child.count;
-        } else {
-            node.count[slot] = Node::kInterior;
-            // The recursion may grow `wide`, so the node is looked up again afterwards.
-            const std::uint32_t first = collapse_node(binary, children[slot], wide);
-            wide[wide_index].first[slot] = first;
-        }
-    }
-    return wide_index;
-}
+    std::uint32_t node_count() const { return next_.load(); }
+
+private:
+    const BvhNode* nodes_;
+    Node* wide_;
+    bool parallel_;
+    /// The root is wide node 0.
+    std::atomic<std::uint32_t> next_{1};
+};
 
 }  // namespace
 
+void* allocate_aligned(std::size_t bytes, std::size_t alignment) {
+    if (!use_huge_pages(bytes)) return ::operator new(bytes, std::align_val_t(alignment));
+    void* pointer = ::operator new(bytes, std::align_val_t(std::max(alignment, kHugePage)));
+    // Advice only: where the kernel has no huge pages (or no THP), nothing changes.
+    madvise(pointer, bytes, MADV_HUGEPAGE);
+    return pointer;
+}
+
+void deallocate_aligned(void* pointer, std::size_t bytes, std::size_t alignment) noexcept {
+    ::operator delete(
+        pointer,
+        std::align_val_t(use_huge_pages(bytes) ? std::max(alignment, kHugePage) : alignment));
+}
+
 template <int kWidth>
-std::vector<WideBvhNode<kWidth>> collapse_to_wide(const BinaryBvh& binary) {
-    std::vector<WideBvhNode<kWidth>> wide;
-    if (binary.nodes.empty()) return wide;
-    wide.reserve(binary.nodes.size() / 2 + 1);
-    collapse_node<kWidth>(binary, 0, wide);
-    wide.shrink_to_fit();
+WideBvhNodes<kWidth> collapse_to_wide(const BinaryBvh& binary, bool parallel) {
+    if (binary.nodes.empty()) return {};
+    // A binary tree of n nodes (n - 1 of them in use: slot 1 is not) collapses into at most
+    // n / 2 + 1 wide nodes. The storage for that many is left uninitialised and cut to the
+    // nodes made, not copied: pages never written are never touched (see the Bvh's stats).
+    WideBvhNodes<kWidth> wide(binary.nodes.size() / 2 + 1);
+    Collapser<kWidth> collapser(binary, wide.data(), parallel);
+    collapser.collapse(0, 0, 0);
+    wide.resize(collapser.node_count());
     return wide;
 }
 
-template std::vector<Bvh4Node> collapse_to_wide<4>(const BinaryBvh&);
-template std::vector<Bvh8Node> collapse_to_wide<8>(const BinaryBvh&);
+template WideBvhNodes<4> collapse_to_wide<4>(const BinaryBvh&, bool);
+template WideBvhNodes<8> collapse_to_wide<8>(const BinaryBvh&, bool);
 
 BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig& config,
                            int leaf_block) {
     BinaryBvh tree;
     if (primitives.empty()) return tree;
     // A binary tree over n primitives has at most n - 1 interior nodes, so 2 n slots hold the
-    // root, the unused slot and every sibling pair. They are left uninitialised: a tree has
-    // about 2 n / (primitives per leaf) nodes, and only the pages written are ever touched.
-    struct Free {
-        void operator()(BvhNode* p) const { ::operator delete(p, std::align_val_t(64)); }
-    };
-    const std::unique_ptr<BvhNode, Free> nodes(static_cast<BvhNode*>(
-        ::operator new(2 * primitives.size() * sizeof(BvhNode), std::align_val_t(64))));
-    nodes.get()[1] = BvhNode{};
-    Builder builder(primitives, config, leaf_block, nodes.get());
-    tree.depth = builder.build(0, builder.root(), 0);
-    tree.nodes.assign(nodes.get(),
-                      nodes.get() + (primitives.size() == 1 ? 1 : builder.node_count()));
+    // root, the unused slot and every sibling pair. They are left uninitialised and the vector
+    // is cut to the nodes made, not copied: a tree has about 2 n / (primitives per leaf) nodes,
+    // and only the pages written are ever touched.
+    tree.nodes.resize(2 * primitives.size());
+    tree.nodes[1] = BvhNode{};
+    Builder builder(primitives, config, leaf_block, tree.nodes.data());
+    const Range root = builder.root();
+    const Subtree built = builder.build(0, root, 0);
+    tree.nodes.resize(primitives.size() == 1 ? 1 : builder.node_count());
+    tree.depth = built.depth;
     tree.leaves = builder.leaf_count();
     tree.indices.resize(primitives.size());
-    for (std::size_t i = 0; i < primitives.size(); ++i) tree.indices[i] = primitives[i].index;
-    tree.sah_cost = sah_cost(tree, config, leaf_block);
+    auto copy_indices = [&](const tbb::blocked_range<std::size_t>& chunk) {
+        for (std::size_t i = chunk.begin(); i != chunk.end(); ++i)
+            tree.indices[i] = primitives[i].index;
+    };
+    const tbb::blocked_range<std::size_t> all(0, primitives.size(), 1u << 14);
+    if (config.parallel) {
+        tbb::parallel_for(all, copy_indices);
+    } else {
+        copy_indices(all);
+    }
+    const double root_area = root.box.half_area();
+    tree.sah_cost = root_area > 0.0 ? built.cost / root_area : 0.0;
     return tree;
 }
 

@@ -89,6 +89,20 @@ struct Float4 {
     void truncate(int* out) const {
         _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_cvttps_epi32(v));
     }
+    /// Each lane truncated toward zero, as a float (lanes must be in int range).
+    Float4 truncated() const {
+        return {_mm_cvtepi32_ps(_mm_cvttps_epi32(v))};
+    }
+    /// The first three lanes of a, b, c as columns: x = (a0, b0, c0, 0), y = (a1, b1, c1, 0),
+    /// z = (a2, b2, c2, 0).
+    friend void transpose3(Float4 a, Float4 b, Float4 c, Float4& x, Float4& y, Float4& z) {
+        const __m128 zero = _mm_setzero_ps();
+        const __m128 ab_low = _mm_unpacklo_ps(a.v, b.v), c_low = _mm_unpacklo_ps(c.v, zero);
+        const __m128 ab_high = _mm_unpackhi_ps(a.v, b.v), c_high = _mm_unpackhi_ps(c.v, zero);
+        x = {_mm_movelh_ps(ab_low, c_low)};
+        y = {_mm_movehl_ps(c_low, ab_low)};
+        z = {_mm_movelh_ps(ab_high, c_high)};
+    }
 #else
     float v[4];
 
@@ -170,6 +184,16 @@ struct Float4 {
     }
     void truncate(int* out) const {
         for (int i = 0; i < 4; ++i) out[i] = static_cast<int>(v[i]);
+    }
+    Float4 truncated() const {
+        Float4 r;
+        for (int i = 0; i < 4; ++i) r.v[i] = static_cast<float>(static_cast<int>(v[i]));
+        return r;
+    }
+    friend void transpose3(Float4 a, Float4 b, Float4 c, Float4& x, Float4& y, Float4& z) {
+        x = {{a.v[0], b.v[0], c.v[0], 0.0f}};
+        y = {{a.v[1], b.v[1], c.v[1], 0.0f}};
+        z = {{a.v[2], b.v[2], c.v[2], 0.0f}};
     }
 #endif
 };

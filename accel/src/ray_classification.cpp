@@ -225,6 +225,7 @@ void RayClassification<Set>::build(const Set& set, const RayClassificationConfig
         cluster_config.parallel = false;
         detail::BinaryBvh tree = detail::build_binary_bvh(primitives, cluster_config);
         clusters_ = std::move(tree.nodes);
+        clusters_.shrink_to_fit();  // the builder leaves room for twice the primitives
         cluster_primitives_ = std::move(tree.indices);
         cluster_sizes_.assign(clusters_.size(), 0);
         auto size_of = [&](auto&& self, std::uint32_t id) -> std::uint32_t {

@@ -65,8 +65,8 @@ public:
     const std::vector<BvhNode, AlignedAllocator<BvhNode>>& binary_nodes() const {
         return binary_nodes_;
     }
-    const std::vector<Bvh4Node>& nodes_4_wide() const { return nodes_4_; }
-    const std::vector<Bvh8Node>& nodes_8_wide() const { return nodes_8_; }
+    const WideBvhNodes<4>& nodes_4_wide() const { return nodes_4_; }
+    const WideBvhNodes<8>& nodes_8_wide() const { return nodes_8_; }
     const std::vector<std::uint32_t>& primitive_indices() const { return indices_; }
     const std::vector<BvhTriangleBlock, AlignedAllocator<BvhTriangleBlock>>& triangle_blocks()
         const {
@@ -86,8 +86,8 @@ private:
     BvhConfig config_;
     bool use_avx2_ = false;
     std::vector<BvhNode, AlignedAllocator<BvhNode>> binary_nodes_;
-    std::vector<Bvh4Node> nodes_4_;
-    std::vector<Bvh8Node> nodes_8_;
+    WideBvhNodes<4> nodes_4_;
+    WideBvhNodes<8> nodes_8_;
     std::vector<std::uint32_t> indices_;
     std::vector<BvhTriangleBlock, AlignedAllocator<BvhTriangleBlock>> blocks_;
     AcceleratorStats stats_;
