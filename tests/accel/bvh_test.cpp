@@ -12,14 +12,14 @@
 #include <tuple>
 #include <type_traits>
 
+#include "accel/grid_test_common.h"
 #include "csgrt/accel/brute_force.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
-#include "csgrt/core/sphere.h"
 #include "support/meshes.h"
 #include "support/random.h"
+#include "support/test_scale.h"
 
 namespace csgrt {
 namespace {
@@ -181,11 +181,12 @@ TYPED_TEST(BvhMeshTest, SameHitsAsBruteForceOnEveryMeshAndLayout) {
         TestMesh mesh;
         int rays;
     };
+    // Label "heavy": test::scaled() of the rays under the sanitizers.
     std::vector<Case> cases;
-    cases.push_back({"integer_cube(8)", test::integer_cube(8), 40000});
-    cases.push_back({"sphere_mesh(5)", test::sphere_mesh(5), 20000});
-    cases.push_back({"thin soup", thin_triangle_soup(4000, 7), 20000});
-    cases.push_back({"teapot in stadium", teapot_in_stadium(), 20000});
+    cases.push_back({"integer_cube(8)", test::integer_cube(8), test::scaled(40000)});
+    cases.push_back({"sphere_mesh(5)", test::sphere_mesh(5), test::scaled(20000)});
+    cases.push_back({"thin soup", thin_triangle_soup(4000, 7), test::scaled(20000)});
+    cases.push_back({"teapot in stadium", teapot_in_stadium(), test::scaled(20000)});
     int total_rays = 0;
     for (const Case& c : cases) {
         const TriangleSet<TypeParam> set(c.mesh.vertices, c.mesh.triangles);
@@ -221,7 +222,7 @@ TYPED_TEST(BvhMeshTest, SameHitsAsBruteForceOnEveryMeshAndLayout) {
             if (all) total_rays += static_cast<int>(subset.size());
         }
     }
-    EXPECT_GE(total_rays, 100000);
+    EXPECT_GE(total_rays, test::scaled(100000));
 }
 
 TYPED_TEST(BvhMeshTest, AllHitsEqualBruteForceAsASet) {
@@ -271,7 +272,8 @@ TEST(Bvh, TriangleBlocksGiveTheScalarTestsBitsOnEdgeAndVertexRays) {
     // t, u or v. Whole lines report every triangle they cross, so all_hits compares the two
     // tests on every triangle the line meets. Rays aimed exactly at shared vertices and at
     // points of shared edges make the edge functions zero or tiny: the double-precision
-    // recomputation and the sign rules are exercised there. A million rays.
+    // recomputation and the sign rules are exercised there. A million rays (label "heavy":
+    // test::scaled() of them under the sanitizers).
     TestMesh fan;
     fan.vertices.emplace_back(0.0, 0.0, 0.0);
     for (int k = 0; k < 12; ++k) {
@@ -291,7 +293,7 @@ TEST(Bvh, TriangleBlocksGiveTheScalarTestsBitsOnEdgeAndVertexRays) {
         {"fan", fan},
         {"soup at 2^-64", tiny}};
     test::Random random(17);
-    const int rays_per_mesh = 250000;
+    const int rays_per_mesh = test::scaled(250000);
     for (const auto& [name, mesh] : meshes) {
         const TriangleSet<float> set(mesh.vertices, mesh.triangles);
         BruteForce<TriangleSet<float>> brute;
@@ -392,38 +394,16 @@ TEST(Bvh, Avx2AndSseTraversalsDoTheSameWorkRayByRay) {
     }
 }
 
-TEST(Bvh, ShapeSetOfTenThousandSpheres) {
-    test::Random random(5);
-    std::vector<std::shared_ptr<const Shape>> spheres;
-    for (int i = 0; i < 10000; ++i) {
-        spheres.push_back(
-            std::make_shared<Sphere>(random.in_box(Aabb(Point3(-10, -10, -10), Point3(10, 10, 10))),
-                                     random.uniform(0.05, 0.4)));
-    }
-    const ShapeSet set(spheres);
-    BruteForce<ShapeSet> brute;
-    brute.build(set);
-    Bvh<ShapeSet> bvh;
-    bvh.build(set);
-    const std::vector<Ray> rays =
-        mixed_rays(Aabb(Point3(-10, -10, -10), Point3(10, 10, 10)), 8000, 6);
-    const int hits = expect_same_answers<ShapeSet>(bvh, brute, rays, "spheres");
-    EXPECT_GT(hits, 2000);
-}
-
 TEST(Bvh, EmptySetAndSinglePrimitive) {
     const TriangleSet<float> empty;
     Bvh<TriangleSet<float>> bvh;
     bvh.build(empty);
+    test::expect_empty_set_answers_nothing(bvh);
+    EXPECT_EQ(bvh.stats().primitives, 0u);
+
     QueryScratch scratch;
     HitRecord record;
     const Ray ray{Point3(0, 0, -1), Vector3(0, 0, 1)};
-    EXPECT_FALSE(bvh.intersect(ray, record, scratch));
-    EXPECT_FALSE(bvh.occluded(ray, scratch));
-    std::vector<HitRecord> hits;
-    bvh.all_hits(ray, hits, scratch);
-    EXPECT_TRUE(hits.empty());
-    EXPECT_EQ(bvh.stats().primitives, 0u);
 
     const std::vector<Eigen::Vector3d> vertices = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
     const std::vector<std::array<std::uint32_t, 3>> triangles = {{0, 1, 2}};

@@ -28,14 +28,9 @@ protected:
         hgrid.build(set, hgrid_config);
         BruteForce<TriangleSet<Real>> brute;
         brute.build(set);
-        const Aabb box = test::mesh_bounds(mesh);
-        std::vector<Ray> rays = test::camera_rays(box, camera, seed);
-        const std::vector<Ray> more = test::incoherent_rays(box, incoherent, seed + 1);
-        const std::vector<Ray> axes = test::axis_rays(box, incoherent / 10, seed + 2);
-        rays.insert(rays.end(), more.begin(), more.end());
-        rays.insert(rays.end(), axes.begin(), axes.end());
-        const test::AgreementCounts counts =
-            test::expect_agreement({&grid, &hgrid}, brute, rays, 16);
+        const test::AgreementCounts counts = test::expect_agreement(
+            {&grid, &hgrid}, brute,
+            test::agreement_rays(test::mesh_bounds(mesh), camera, incoherent, seed), 16);
         // Every mesh here is hit by a good share of these rays; a structure that missed
         // everything would agree with nothing.
         EXPECT_GT(counts.hits, counts.rays / 5)
@@ -54,8 +49,8 @@ TYPED_TEST(GridAgreementTest, IntegerCube) {
 
 TYPED_TEST(GridAgreementTest, SphereMesh) {
     // 8,192 triangles: each brute-force answer is costly, so fewer rays here (the real meshes
-    // of grid_reference_test.cpp, up to 52,000 triangles, are compared with brute force on a
-    // sample of rays).
+    // of structure_reference_test.cpp, up to 52,000 triangles, are compared with brute force
+    // and CGAL there).
     EXPECT_EQ(this->expect_agreement_on(test::sphere_mesh(5), 3000, 3000, 102), 6300);
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 
-// Scenes, ray sets and the brute-force agreement check shared by the regular and hierarchical
-// grid tests.
+// Scenes, ray sets, the brute-force agreement check and the checks every structure passes alike
+// (invalid rays, the empty set, one triangle, identical copies), shared by the regular grid,
+// hierarchical grid and ray classification tests.
 
 #include <gtest/gtest.h>
 
@@ -14,23 +15,19 @@
 
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/brute_force.h"
+#include "csgrt/accel/factory.h"
 #include "csgrt/accel/regular_grid.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/sphere.h"
 #include "support/meshes.h"
 #include "support/random.h"
+#include "support/rays.h"
+#include "support/unbounded_plane.h"
 
 namespace csgrt::test {
 
 inline constexpr float kInfinityF = std::numeric_limits<float>::infinity();
-
-/// The box of a mesh's vertices.
-inline Aabb mesh_bounds(const TestMesh& mesh) {
-    Aabb box;
-    for (const Eigen::Vector3d& v : mesh.vertices) box.extend(v);
-    return box;
-}
 
 /// Appends `other` to `mesh`, its vertices mapped by p -> scale * p + offset.
 inline void append(TestMesh& mesh, const TestMesh& other, double scale = 1.0,
@@ -105,70 +102,6 @@ inline std::vector<std::shared_ptr<const Shape>> random_spheres(int count, std::
     for (int i = 0; i < count; ++i)
         shapes.push_back(std::make_shared<Sphere>(random.in_box(box), random.uniform(0.02, 0.3)));
     return shapes;
-}
-
-/// Gives some rays a finite interval: t_max cut at a random point, t_min moved forward or to
-/// -infinity, so both ends of [t_min, t_max] are exercised.
-inline void random_interval(Random& random, Ray& ray) {
-    switch (random.integer(0, 5)) {
-        case 0:
-            ray.t_max = random.uniform(0.0, 2.0);
-            break;
-        case 1:
-            ray.t_min = random.uniform(0.0, 1.0);
-            break;
-        case 2:
-            ray.t_min = -kInfinity;
-            break;
-        case 3:
-            ray.t_min = random.uniform(-1.0, 1.0);
-            ray.t_max = ray.t_min + random.uniform(0.0, 2.0);
-            break;
-        default:
-            break;
-    }
-}
-
-/// Camera-like rays: from points on a shell around `box` (1 to 2 box sizes out) toward random
-/// points of the box.
-inline std::vector<Ray> camera_rays(const Aabb& box, int count, std::uint64_t seed) {
-    Random random(seed);
-    std::vector<Ray> rays;
-    const double size = box.diagonal().norm();
-    for (int i = 0; i < count; ++i) {
-        const Point3 eye = box.center() + random.unit_vector() * size * random.uniform(1.0, 2.0);
-        const Point3 target = random.in_box(box);
-        rays.push_back(Ray{eye, (target - eye) * random.uniform(0.25, 4.0) / size});
-        if (i % 4 == 0) random_interval(random, rays.back());
-    }
-    return rays;
-}
-
-/// Incoherent rays: random origins in and around `box` (half of them inside), random
-/// directions of random length.
-inline std::vector<Ray> incoherent_rays(const Aabb& box, int count, std::uint64_t seed) {
-    Random random(seed);
-    std::vector<Ray> rays;
-    const Aabb around = enlarged(box, 0.5);
-    for (int i = 0; i < count; ++i) {
-        const Point3 origin = random.in_box(i % 2 ? box : around);
-        rays.push_back(Ray{origin, random.unit_vector() * random.uniform(0.25, 4.0)});
-        if (i % 4 == 0) random_interval(random, rays.back());
-    }
-    return rays;
-}
-
-/// Rays parallel to the axes (exact zero components), from random points in and around `box`.
-inline std::vector<Ray> axis_rays(const Aabb& box, int count, std::uint64_t seed) {
-    Random random(seed);
-    std::vector<Ray> rays;
-    const Aabb around = enlarged(box, 0.2);
-    for (int i = 0; i < count; ++i) {
-        Vector3 direction = Vector3::Zero();
-        direction[i % 3] = (i / 3) % 2 ? 1.5 : -0.5;
-        rays.push_back(Ray{random.in_box(around), direction});
-    }
-    return rays;
 }
 
 /// The exact answer of a structure for one ray, to compare across structures and threads.
@@ -433,6 +366,203 @@ inline std::vector<Ray> invalid_rays() {
             Ray{Point3(0.5, 0.5, -5), Vector3(0, 0, 1), 3.0, 2.0},
             Ray{Point3(0.5, 0.5, -5), Vector3(0, 0, 1), nan, 10.0},
             Ray{Point3(0.5, 0.5, -5), Vector3(0, 0, 1), 0.0, nan}};
+}
+
+/// A triangle set in precision Real built from `mesh`, with brute force and a `Structure` built
+/// over it. Not movable: both structures point into the set.
+template <class Real, template <class> class Structure>
+struct BuiltMesh {
+    using Set = TriangleSet<Real>;
+
+    template <class... Config>
+    explicit BuiltMesh(const TestMesh& mesh, const Config&... config)
+        : set(mesh.vertices, mesh.triangles) {
+        brute.build(set);
+        structure.build(set, config...);
+    }
+    BuiltMesh(const BuiltMesh&) = delete;
+    BuiltMesh& operator=(const BuiltMesh&) = delete;
+
+    Set set;
+    BruteForce<Set> brute;
+    Structure<Set> structure;
+};
+
+/// Camera-like and incoherent rays around `box`, and a tenth as many axis-parallel ones.
+inline std::vector<Ray> agreement_rays(const Aabb& box, int camera, int incoherent,
+                                       std::uint64_t seed) {
+    std::vector<Ray> rays = camera_rays(box, camera, seed);
+    const std::vector<Ray> more = incoherent_rays(box, incoherent, seed + 1);
+    const std::vector<Ray> axes = axis_rays(box, incoherent / 10, seed + 2);
+    rays.insert(rays.end(), more.begin(), more.end());
+    rays.insert(rays.end(), axes.begin(), axes.end());
+    return rays;
+}
+
+/// Builds a `Structure` (with `config`) and brute force over `mesh` in precision Real and
+/// checks them against each other on agreement_rays; a good share of the rays must hit (a
+/// structure that missed everything would agree with nothing). Returns the rays checked.
+template <class Real, template <class> class Structure, class... Config>
+int expect_agreement_on_mesh(const TestMesh& mesh, int camera, int incoherent, std::uint64_t seed,
+                             const Config&... config) {
+    const BuiltMesh<Real, Structure> built(mesh, config...);
+    const AgreementCounts counts = expect_agreement(
+        built.structure, built.brute, agreement_rays(mesh_bounds(mesh), camera, incoherent, seed));
+    EXPECT_GT(counts.hits, counts.rays / 5) << built.structure.stats().details;
+    return counts.rays;
+}
+
+/// Rays in and just off the plane z = 0 of flat_soup (in it, grazing it within 1e-6) and rays
+/// from above it, from random points over [-2, 12]^2.
+inline std::vector<Ray> rays_along_a_plane(int count, std::uint64_t seed) {
+    Random random(seed);
+    std::vector<Ray> rays;
+    for (int n = 0; n < count; ++n) {
+        const Point3 origin(random.uniform(-2, 12), random.uniform(-2, 12), 0.0);
+        Vector3 direction = random.unit_vector();
+        switch (n % 3) {
+            case 0:
+                direction.z() = 0.0;
+                break;
+            case 1:
+                direction.z() = random.uniform(-1e-6, 1e-6);
+                break;
+            default:
+                rays.push_back(Ray{origin + Vector3(0, 0, 3), direction});
+        }
+        rays.push_back(Ray{origin, direction});
+    }
+    return rays;
+}
+
+/// Appends two rays lying exactly in a cell boundary plane of `grid` (the n-th of a sequence:
+/// the plane's axis cycles, and every second ray also lies in a plane of a second axis, so it
+/// runs along a cell edge), from a random point of the grid's bounds enlarged by `margin`; and
+/// the same ray moved into an integer plane of the mesh (integer_cube(6)).
+inline void add_cell_boundary_rays(const detail::GridGeometry& grid, int n, double margin,
+                                   Random& random, std::vector<Ray>& rays) {
+    auto plane = [&](int axis, int i) {
+        return grid.bounds.lower[axis] + i * grid.cell_size[axis];
+    };
+    const int axis = n % 3, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+    Point3 origin = random.in_box(enlarged(grid.bounds, margin));
+    Vector3 direction = random.unit_vector();
+    // In a boundary plane (including the faces, i = 0 and i = resolution).
+    origin[axis] = plane(axis, random.integer(0, grid.resolution[axis]));
+    direction[axis] = 0.0;
+    if (n % 2 == 0) {
+        // Along a cell edge: also in a plane of a second axis, moving along the third.
+        origin[a1] = plane(a1, random.integer(0, grid.resolution[a1]));
+        direction[a1] = 0.0;
+        direction[a2] = n % 4 ? 1.0 : -2.0;
+    }
+    rays.push_back(Ray{origin, direction});
+    Point3 on_mesh_plane = origin;
+    on_mesh_plane[axis] = random.integer(0, 6);
+    rays.push_back(Ray{on_mesh_plane, direction});
+}
+
+/// No query of `structure` answers any of invalid_rays(): intersect, occluded (counted or
+/// not) and all_hits.
+template <class Set>
+void expect_invalid_rays_answer_nothing(const Accelerator<Set>& structure) {
+    QueryScratch scratch;
+    for (const Ray& ray : invalid_rays()) {
+        HitRecord record;
+        TraversalCounters counters;
+        EXPECT_FALSE(structure.intersect(ray, record, scratch));
+        EXPECT_FALSE(structure.intersect_counted(ray, record, scratch, counters));
+        EXPECT_FALSE(structure.occluded(ray, scratch));
+        EXPECT_FALSE(structure.occluded_counted(ray, scratch, counters));
+        std::vector<HitRecord> hits;
+        structure.all_hits(ray, hits, scratch);
+        EXPECT_TRUE(hits.empty());
+    }
+}
+
+/// A structure built over an empty set answers nothing.
+template <class Set>
+void expect_empty_set_answers_nothing(const Accelerator<Set>& structure) {
+    QueryScratch scratch;
+    HitRecord record;
+    const Ray ray{Point3(0, 0, -1), Vector3(0, 0, 1)};
+    EXPECT_FALSE(structure.intersect(ray, record, scratch));
+    EXPECT_FALSE(structure.occluded(ray, scratch));
+    std::vector<HitRecord> hits;
+    structure.all_hits(ray, hits, scratch);
+    EXPECT_TRUE(hits.empty());
+}
+
+/// The triangle (0, 0, 0), (2, 0, 0), (0, 2, 0), for expect_single_triangle_answers.
+inline TestMesh single_triangle() {
+    TestMesh mesh;
+    mesh.vertices = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+    mesh.triangles = {{0, 1, 2}};
+    return mesh;
+}
+
+/// A structure over single_triangle(): the exact hit t = 0.5 of a ray along z through it, the
+/// closed interval [t_min, t_max] honoured at both ends, and a miss beside it.
+template <class Set>
+void expect_single_triangle_answers(const Accelerator<Set>& structure) {
+    QueryScratch scratch;
+    HitRecord record;
+    ASSERT_TRUE(structure.intersect(Ray{Point3(0.5, 0.5, -1), Vector3(0, 0, 2)}, record, scratch));
+    EXPECT_EQ(record.t, 0.5);
+    EXPECT_EQ(record.primitive, 0u);
+    EXPECT_TRUE(structure.occluded(Ray{Point3(0.5, 0.5, -1), Vector3(0, 0, 2), 0.5, 0.5}, scratch));
+    EXPECT_FALSE(structure.occluded(
+        Ray{Point3(0.5, 0.5, -1), Vector3(0, 0, 2), 0.0, std::nextafter(0.5, 0.0)}, scratch));
+    EXPECT_FALSE(structure.occluded(
+        Ray{Point3(0.5, 0.5, -1), Vector3(0, 0, 2), std::nextafter(0.5, 1.0), kInfinity}, scratch));
+    EXPECT_FALSE(structure.intersect(Ray{Point3(1.5, 1.5, -1), Vector3(0, 0, 1)}, record, scratch));
+}
+
+/// A structure over identical_triangles(copies): the tie goes to the lowest index, and
+/// all_hits reports every copy exactly once (more copies than a mailbox has slots).
+template <class Set>
+void expect_identical_copies_each_once(const Accelerator<Set>& structure, std::size_t copies) {
+    QueryScratch scratch;
+    const Ray ray{Point3(0.2, 0.2, 5), Vector3(0, 0, -1)};
+    HitRecord record;
+    ASSERT_TRUE(structure.intersect(ray, record, scratch));
+    EXPECT_EQ(record.primitive, 0u);
+    std::vector<HitRecord> hits;
+    structure.all_hits(ray, hits, scratch);
+    ASSERT_EQ(hits.size(), copies);
+    std::vector<bool> seen(copies, false);
+    for (const HitRecord& hit : hits) seen[hit.primitive] = true;
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), true), static_cast<long>(copies));
+}
+
+/// Both twins of twin_triangles_across_a_cell_boundary (primitives 16 and 17) are brute force's
+/// nearest hit on some of `rays`, or the case would test nothing.
+template <class Set>
+void expect_both_twins_win(const BruteForce<Set>& brute, const std::vector<Ray>& rays) {
+    QueryScratch scratch;
+    int far_wins = 0, near_wins = 0;
+    for (const Ray& ray : rays) {
+        HitRecord record;
+        ASSERT_TRUE(brute.intersect(ray, record, scratch));
+        far_wins += record.primitive == 16;
+        near_wins += record.primitive == 17;
+    }
+    EXPECT_GT(far_wins, 0);
+    EXPECT_GT(near_wins, 0);
+}
+
+/// make_accelerator(name, set, config) builds the structure `name` over `set`, with stats
+/// that count every primitive at least once.
+template <class Set>
+void expect_factory_builds(std::string_view name, const Set& set, const AcceleratorConfig& config) {
+    const auto structure = make_accelerator(name, set, config);
+    EXPECT_EQ(structure->name(), name);
+    const AcceleratorStats stats = structure->stats();
+    EXPECT_EQ(stats.primitives, set.size());
+    EXPECT_GT(stats.nodes, 0u);
+    EXPECT_GE(stats.references, set.size());
+    EXPECT_GT(stats.bytes, 0u);
+    EXPECT_FALSE(stats.details.empty());
 }
 
 }  // namespace csgrt::test

@@ -15,6 +15,7 @@
 #include "csgrt/csg/scene_file.h"
 #include "support/random.h"
 #include "support/shape_properties.h"
+#include "support/test_scale.h"
 
 namespace csgrt {
 namespace {
@@ -397,8 +398,9 @@ TEST(Compound, TenThousandObjectSceneHierarchyMatchesBruteForceWithFarFewerTests
     TraversalCounters brute_counters, automatic_counters;
     long hierarchy_calls = 0;
     int hits = 0;
-    constexpr int kRays = 10'000;
-    for (int i = 0; i < kRays; ++i) {
+    // Label "heavy": test::scaled() of the rays under the sanitizers.
+    const int ray_count = test::scaled(10'000);
+    for (int i = 0; i < ray_count; ++i) {
         // Half camera rays over the whole film, half random rays through the grid's slab.
         const Ray ray =
             i % 2 ? brute.camera().generate_ray(random.uniform(), random.uniform(), 16.0 / 9.0)
@@ -421,18 +423,18 @@ TEST(Compound, TenThousandObjectSceneHierarchyMatchesBruteForceWithFarFewerTests
         EXPECT_EQ(grouped->geometric_normal, expected->geometric_normal) << i;
         EXPECT_EQ(grouped->shape, expected->shape) << i;
     }
-    EXPECT_GT(hits, kRays / 2);
+    EXPECT_GT(hits, ray_count / 2);
     // Brute force tests all 10,001 objects (the ground included) on every ray.
-    EXPECT_EQ(brute_counters.primitives_tested, 10'001u * kRays);
-    const double brute_per_ray = double(brute_counters.primitives_tested) / kRays;
-    const double hierarchy_per_ray = double(hierarchy_calls) / kRays;
-    const double automatic_per_ray = double(automatic_counters.primitives_tested) / kRays;
+    EXPECT_EQ(brute_counters.primitives_tested, 10'001u * static_cast<unsigned>(ray_count));
+    const double brute_per_ray = double(brute_counters.primitives_tested) / ray_count;
+    const double hierarchy_per_ray = double(hierarchy_calls) / ray_count;
+    const double automatic_per_ray = double(automatic_counters.primitives_tested) / ray_count;
     std::printf(
         "objects tested per ray: brute %.0f, hierarchy of compounds %.1f, scene's %s %.1f "
         "(%.1f nodes, %.1f boxes)\n",
         brute_per_ray, hierarchy_per_ray, std::string(automatic.accelerator_name()).c_str(),
-        automatic_per_ray, double(automatic_counters.nodes_visited) / kRays,
-        double(automatic_counters.boxes_tested) / kRays);
+        automatic_per_ray, double(automatic_counters.nodes_visited) / ray_count,
+        double(automatic_counters.boxes_tested) / ray_count);
     EXPECT_GT(brute_per_ray, 50.0 * hierarchy_per_ray);
     // The scene's own "auto" choice over 10,001 objects is the BVH.
     EXPECT_EQ(automatic.accelerator_name(), "bvh");

@@ -3,8 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/cgal_reference.h"
@@ -81,19 +85,18 @@ long double ambiguity_band(const TriangleSet<Real>& set, std::size_t i, const Ra
     return ulps * unit * magnitude / cosine;
 }
 
-/// Compares `structure` with CGAL on one ray and tallies the result. Hit/miss and the nearest
-/// primitive must agree unless the ray is within the ambiguity band of an involved triangle.
-/// When both name the same primitive, the hit points along the ray must agree to the band's
-/// width: |t - t_exact| |d| <= ambiguity_band (the same derivation: an error of the footprint
-/// becomes an error along the ray stretched by 1 / |cos theta|).
+/// Judges one answer of a structure (`hit`, and `record` when it hit) against CGAL's exact
+/// answer `exact` for the same ray, and tallies it. Hit/miss and the nearest primitive must
+/// agree unless the ray is within the ambiguity band of an involved triangle. When both name
+/// the same primitive, the hit points along the ray must agree to the band's width:
+/// |t - t_exact| |d| <= ambiguity_band (the same derivation: an error of the footprint becomes
+/// an error along the ray stretched by 1 / |cos theta|).
 template <class Real>
-void compare_with_reference(const Accelerator<TriangleSet<Real>>& structure,
-                            const TriangleSet<Real>& set, const CgalReference& reference,
-                            const Ray& ray, QueryScratch& scratch, ReferenceTally& tally) {
+void judge_against_reference(const TriangleSet<Real>& set, const CgalReference& reference,
+                             const Ray& ray, bool hit, const HitRecord& record,
+                             const std::optional<CgalReference::Answer>& exact,
+                             ReferenceTally& tally) {
     ++tally.rays;
-    HitRecord record;
-    const bool hit = structure.intersect(ray, record, scratch);
-    const std::optional<CgalReference::Answer> exact = reference.nearest(ray);
     if (hit) ++tally.hits;
     auto in_band = [&](std::uint32_t primitive) {
         return distance_to_boundary(set, primitive, ray) <= ambiguity_band(set, primitive, ray);
@@ -134,5 +137,40 @@ void compare_with_reference(const Accelerator<TriangleSet<Real>>& structure,
         ++tally.clear;
     }
 }
+
+/// Queries `structure` with one ray and judges its answer against CGAL's (computed here; see
+/// ReferenceAnswers to compute it once for many structures).
+template <class Real>
+void compare_with_reference(const Accelerator<TriangleSet<Real>>& structure,
+                            const TriangleSet<Real>& set, const CgalReference& reference,
+                            const Ray& ray, QueryScratch& scratch, ReferenceTally& tally) {
+    HitRecord record;
+    const bool hit = structure.intersect(ray, record, scratch);
+    judge_against_reference(set, reference, ray, hit, record, reference.nearest(ray), tally);
+}
+
+/// CGAL answers rays and segments, not whole lines: a t_min of -infinity becomes one far enough
+/// back to put the whole of `box` inside the interval.
+inline void bound_for_reference(std::vector<Ray>& rays, const Aabb& box) {
+    const double reach = box.diagonal().norm();
+    for (Ray& ray : rays) {
+        if (ray.t_min == -kInfinity)
+            ray.t_min = -2.0 * ((ray.origin - box.center()).norm() + reach) / ray.direction.norm();
+    }
+}
+
+/// Rays with CGAL's exact nearest answer for each, computed once so that every structure and
+/// both precisions are judged against it without paying for CGAL again (the sets judged must
+/// hold the corners the reference was built over: float-representable ones serve both).
+struct ReferenceAnswers {
+    std::vector<Ray> rays;
+    std::vector<std::optional<CgalReference::Answer>> exact;
+
+    ReferenceAnswers(const CgalReference& reference, std::vector<Ray> rays_in)
+        : rays(std::move(rays_in)) {
+        exact.reserve(rays.size());
+        for (const Ray& ray : rays) exact.push_back(reference.nearest(ray));
+    }
+};
 
 }  // namespace csgrt::test
