@@ -16,6 +16,13 @@
 #include "bvh_simd.h"
 #include "csgrt/accel/bvh_build.h"
 
+// GCC says __SANITIZE_ADDRESS__, clang __has_feature(address_sanitizer).
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define CSGRT_ADDRESS_SANITIZER 1
+#endif
+#endif
+
 namespace csgrt::detail {
 
 namespace {
@@ -26,11 +33,6 @@ constexpr std::size_t kHugePage = std::size_t{2} << 20;
 /// rounding waste stays small). Not under AddressSanitizer, whose allocator would be handed
 /// an alignment it does not need and whose pages are its own business.
 bool use_huge_pages(std::size_t bytes) {
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define CSGRT_ADDRESS_SANITIZER 1
-#endif
-#endif
 #if defined(__SANITIZE_ADDRESS__) || defined(CSGRT_ADDRESS_SANITIZER)
     (void)bytes;
     return false;
