@@ -9,6 +9,7 @@
 #include "csgrt/core/instance.h"
 #include "csgrt/core/sphere.h"
 #include "csgrt/csg/boolean.h"
+#include "support/membership.h"
 #include "support/random.h"
 
 // Counts operator new calls on this thread while `counting` is set, to show that queries on a
@@ -89,15 +90,7 @@ struct Model {
         const RealVector local = node.inverse_linear * (p - node.translation);
         if (node.leaf) return local.squaredNorm() < 1;
         const bool a = contains(node.first, local), b = contains(node.second, local);
-        switch (node.operation) {
-            case BooleanOperation::Union:
-                return a || b;
-            case BooleanOperation::Intersection:
-                return a && b;
-            case BooleanOperation::Difference:
-                return a && !b;
-        }
-        return false;
+        return test::combine_membership(node.operation, a, b);
     }
     bool contains(const RealVector& p) const { return contains(root, p); }
 };

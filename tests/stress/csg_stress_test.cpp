@@ -21,6 +21,7 @@
 #include "stress/reference_shapes.h"
 #include "stress/stress_config.h"
 #include "stress/summary.h"
+#include "support/membership.h"
 #include "support/meshes.h"
 #include "support/random.h"
 
@@ -260,15 +261,7 @@ struct Model {
             return leaf.inside(leaf.linear.inverse() * (p - leaf.translation));
         }
         const bool a = contains(node.first, p), b = contains(node.second, p);
-        switch (node.operation) {
-            case BooleanOperation::Union:
-                return a || b;
-            case BooleanOperation::Intersection:
-                return a && b;
-            case BooleanOperation::Difference:
-                return a && !b;
-        }
-        return false;
+        return test::combine_membership(node.operation, a, b);
     }
     bool contains(const LongVector& p) const { return contains(root, p); }
 };
