@@ -43,6 +43,21 @@ double scene_magnitude(const Scene& scene) {
     return magnitude;
 }
 
+/// What one worker counts for the statistics (RenderStats), summed when the render ends.
+struct RayTally {
+    std::uint64_t shadow_rays = 0;
+    std::uint64_t shadow_rays_blocked = 0;
+    std::uint64_t primary_hits = 0;
+    TraversalCounters centre_ray_work;
+    /// Sized to the scene's objects once per worker, so counting allocates nothing per ray.
+    std::vector<std::uint64_t> hits_per_object;
+
+    void count_hit(std::uint32_t object_id) {
+        ++primary_hits;
+        if (object_id < hits_per_object.size()) ++hits_per_object[object_id];
+    }
+};
+
 Vector3 albedo_of(const Scene& scene, std::uint32_t object_id) {
     if (object_id >= scene.objects().size()) return Material{}.albedo;
     const std::uint32_t material = scene.objects()[object_id].material;
@@ -52,7 +67,7 @@ Vector3 albedo_of(const Scene& scene, std::uint32_t object_id) {
 
 /// Linear radiance leaving `hit` toward the camera along `ray` (unit direction).
 Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
-              std::uint64_t& shadow_rays) {
+              RayTally& tally) {
     const Vector3 albedo = albedo_of(frame.scene, hit.object_id);
     const Vector3 view = -ray.direction;
     // Both sides of every surface are shaded: turn the normals to the side the ray came from.
@@ -93,15 +108,18 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
         const double cosine = shading.dot(to_light);
         // A light behind the surface (by either normal) sends nothing and needs no shadow ray.
         if (!(cosine > 0.0) || !(geometric.dot(to_light) > 0.0)) continue;
-        ++shadow_rays;
-        if (frame.scene.occluded(shadow, scratch)) continue;
+        ++tally.shadow_rays;
+        if (frame.scene.occluded(shadow, scratch)) {
+            ++tally.shadow_rays_blocked;
+            continue;
+        }
         radiance += albedo.cwiseProduct(irradiance) * (cosine / kPi);
     }
     return radiance;
 }
 
 void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& scratch,
-                  std::uint64_t& shadow_rays) {
+                  RayTally& tally) {
     const RenderSettings& settings = frame.settings;
     const double width = settings.width;
     const double height = settings.height;
@@ -111,7 +129,11 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
     TraversalCounters counters;
     const std::optional<Hit> centre_hit = frame.scene.intersect_counted(centre, scratch, counters);
     pixel.cost = static_cast<float>(counters.nodes_visited + counters.primitives_tested);
+    tally.centre_ray_work.nodes_visited += counters.nodes_visited;
+    tally.centre_ray_work.primitives_tested += counters.primitives_tested;
+    tally.centre_ray_work.boxes_tested += counters.boxes_tested;
     if (centre_hit) {
+        tally.count_hit(centre_hit->object_id);
         pixel.depth = static_cast<float>(centre_hit->t);
         pixel.normal_x = static_cast<float>(centre_hit->shading_normal.x());
         pixel.normal_y = static_cast<float>(centre_hit->shading_normal.y());
@@ -123,7 +145,7 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
     int covered = 0;
     if (settings.samples_per_pixel == 1) {
         if (centre_hit) {
-            colour = shade(frame, centre, *centre_hit, scratch, shadow_rays);
+            colour = shade(frame, centre, *centre_hit, scratch, tally);
             covered = 1;
         }
     } else {
@@ -133,7 +155,8 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
             const Ray ray = frame.film.ray((x + film.x()) / width, (y + film.y()) / height);
             const std::optional<Hit> hit = frame.scene.intersect(ray, scratch);
             if (!hit) continue;
-            colour += shade(frame, ray, *hit, scratch, shadow_rays);
+            tally.count_hit(hit->object_id);
+            colour += shade(frame, ray, *hit, scratch, tally);
             ++covered;
         }
     }
@@ -173,25 +196,28 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
     const int tiles_x = (settings.width + settings.tile_size - 1) / settings.tile_size;
     const int tiles_y = (settings.height + settings.tile_size - 1) / settings.tile_size;
     const int tile_count = tiles_x * tiles_y;
-    // One scratch per worker thread, reused across its tiles.
+    // One scratch and one tally per worker thread, reused across its tiles.
     tbb::enumerable_thread_specific<QueryScratch> scratches;
-    std::atomic<std::uint64_t> shadow_rays{0};
+    tbb::enumerable_thread_specific<RayTally> tallies([&scene] {
+        RayTally tally;
+        tally.hits_per_object.assign(scene.objects().size(), 0);
+        return tally;
+    });
     std::atomic<int> tiles_done{0};
 
     auto render_tiles = [&](const tbb::blocked_range<int>& range) {
         QueryScratch& scratch = scratches.local();
+        RayTally& tally = tallies.local();
         for (int tile = range.begin(); tile != range.end(); ++tile) {
             const int x0 = (tile % tiles_x) * settings.tile_size;
             const int y0 = (tile / tiles_x) * settings.tile_size;
             const int x1 = std::min(x0 + settings.tile_size, settings.width);
             const int y1 = std::min(y0 + settings.tile_size, settings.height);
-            std::uint64_t tile_shadow_rays = 0;
             for (int y = y0; y < y1; ++y) {
                 for (int x = x0; x < x1; ++x) {
-                    render_pixel(frame, x, y, result.image.at(x, y), scratch, tile_shadow_rays);
+                    render_pixel(frame, x, y, result.image.at(x, y), scratch, tally);
                 }
             }
-            shadow_rays += tile_shadow_rays;
             const int done = ++tiles_done;
             if (settings.progress) settings.progress(double(done) / tile_count);
         }
@@ -209,7 +235,19 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
     const auto pixels = static_cast<std::uint64_t>(result.image.pixel_count());
     const auto samples = static_cast<std::uint64_t>(settings.samples_per_pixel);
     result.stats.primary_rays = pixels * samples + (samples > 1 ? pixels : 0);
-    result.stats.shadow_rays = shadow_rays.load();
+    // Integer sums: the same whichever thread counted what.
+    result.stats.hits_per_object.assign(scene.objects().size(), 0);
+    for (const RayTally& tally : tallies) {
+        result.stats.shadow_rays += tally.shadow_rays;
+        result.stats.shadow_rays_blocked += tally.shadow_rays_blocked;
+        result.stats.primary_hits += tally.primary_hits;
+        result.stats.centre_ray_work.nodes_visited += tally.centre_ray_work.nodes_visited;
+        result.stats.centre_ray_work.primitives_tested += tally.centre_ray_work.primitives_tested;
+        result.stats.centre_ray_work.boxes_tested += tally.centre_ray_work.boxes_tested;
+        for (std::size_t i = 0; i < tally.hits_per_object.size(); ++i) {
+            result.stats.hits_per_object[i] += tally.hits_per_object[i];
+        }
+    }
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

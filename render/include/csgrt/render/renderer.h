@@ -2,6 +2,9 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
+
+#include "csgrt/accel/accelerator.h"
 
 #include "csgrt/render/image.h"
 
@@ -38,6 +41,15 @@ struct RenderStats {
     /// feeds the AOVs.
     std::uint64_t primary_rays = 0;
     std::uint64_t shadow_rays = 0;
+    /// Shadow rays that found something between the surface and the light.
+    std::uint64_t shadow_rays_blocked = 0;
+    /// Camera rays that hit an object (colour samples and the separate centre rays).
+    std::uint64_t primary_hits = 0;
+    /// Camera-ray hits per top-level object, indexed by object id.
+    std::vector<std::uint64_t> hits_per_object;
+    /// The top-level structure's work for the centre rays, summed over the image (the cost
+    /// channel's total): nodes or cells visited, primitives tested, boxes tested.
+    TraversalCounters centre_ray_work;
     double seconds = 0.0;
 
     double million_rays_per_second() const {
