@@ -200,8 +200,8 @@ void print_statistics(std::ostream& out, const Scene& scene, const RenderStats& 
     row("primitives tested", stats.centre_ray_work.primitives_tested);
     row("boxes tested", stats.centre_ray_work.boxes_tested);
     out << "Time\n";
-    const std::array<const char*, 4> stages = {"load scene", "commit (build structures)",
-                                               "render", "write files"};
+    const std::array<const char*, 4> stages = {"load scene", "commit (build structures)", "render",
+                                               "write files"};
     for (std::size_t i = 0; i < stages.size(); ++i) {
         char line[96];
         std::snprintf(line, sizeof(line), "  %-28s %14.3f s\n", stages[i], stage_seconds[i]);

@@ -243,9 +243,9 @@ ExrFile read_exr(const std::filesystem::path& path) {
                 const ChannelSpec& channel = kChannels[c];
                 if (found[c] || !file.header(part).channels().findChannel(channel.name)) continue;
                 found[c] = true;
-                frame_buffer.insert(channel.name, Imf::Slice::Make(channel.memory_type,
-                                                                   base + channel.offset, window,
-                                                                   sizeof(Pixel), row));
+                frame_buffer.insert(channel.name,
+                                    Imf::Slice::Make(channel.memory_type, base + channel.offset,
+                                                     window, sizeof(Pixel), row));
             }
             Imf::InputPart input(file, part);
             input.setFrameBuffer(frame_buffer);
@@ -272,8 +272,8 @@ ExrFile read_exr(const std::filesystem::path& path) {
         read_attribute<Imf::DoubleAttribute>(header, "cameraOrthographicHeight",
                                              metadata.camera.orthographic_height);
         read_attribute<Imf::StringAttribute>(header, "accelerator", metadata.accelerator);
-        metadata.include_timing = header.findTypedAttribute<Imf::DoubleAttribute>(
-                                      "acceleratorBuildMs") != nullptr;
+        metadata.include_timing =
+            header.findTypedAttribute<Imf::DoubleAttribute>("acceleratorBuildMs") != nullptr;
         read_attribute<Imf::DoubleAttribute>(header, "acceleratorBuildMs",
                                              metadata.accelerator_build_milliseconds);
         read_attribute<Imf::DoubleAttribute>(header, "renderSeconds", metadata.render_seconds);

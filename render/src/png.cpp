@@ -194,8 +194,8 @@ void write_cost_png(const std::filesystem::path& path, const Image& image) {
     const int bar_right = width - margin;  // exclusive
     const int bar_top = top + 3 * unit;
     for (int x = bar_left; x < bar_right; ++x) {
-        const double t = bar_right - bar_left > 1 ? double(x - bar_left) / (bar_right - bar_left - 1)
-                                                  : 0.0;
+        const double t =
+            bar_right - bar_left > 1 ? double(x - bar_left) / (bar_right - bar_left - 1) : 0.0;
         canvas.fill(x, bar_top, x + 1, bar_top + 10 * unit, viridis8(t));
     }
     const int tick_top = bar_top + 10 * unit;

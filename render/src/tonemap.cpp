@@ -17,9 +17,12 @@ ToneCurve parse_tone_curve(std::string_view name) {
 
 std::string_view tone_curve_name(ToneCurve curve) {
     switch (curve) {
-        case ToneCurve::Clamp: return "clamp";
-        case ToneCurve::Reinhard: return "reinhard";
-        case ToneCurve::Filmic: return "filmic";
+        case ToneCurve::Clamp:
+            return "clamp";
+        case ToneCurve::Reinhard:
+            return "reinhard";
+        case ToneCurve::Filmic:
+            return "filmic";
     }
     return "filmic";
 }
@@ -28,8 +31,10 @@ double tone_map(double linear, const ToneMapping& mapping) {
     // NaN-safe: a NaN or a negative value becomes 0 before the curve.
     const double x = linear > 0.0 ? linear * std::exp2(mapping.exposure_stops) : 0.0;
     switch (mapping.curve) {
-        case ToneCurve::Clamp: return std::min(x, 1.0);
-        case ToneCurve::Reinhard: return std::isinf(x) ? 1.0 : x / (1.0 + x);
+        case ToneCurve::Clamp:
+            return std::min(x, 1.0);
+        case ToneCurve::Reinhard:
+            return std::isinf(x) ? 1.0 : x / (1.0 + x);
         case ToneCurve::Filmic: {
             if (std::isinf(x)) return 1.0;
             const double s = 0.6 * x;  // Narkowicz's scale from ACES's input to the fit's

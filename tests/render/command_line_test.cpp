@@ -188,9 +188,9 @@ TEST_F(CommandLine, StatsPrintsATableOfRaysHitsWorkAndTimes) {
     const ProgramRun result = run({"render", scene_, "-o", output_, "--width", "20", "--height",
                                    "10", "--accel", "brute", "--stats", "--tonemap", "reinhard"});
     ASSERT_EQ(result.status, 0) << result.err;
-    for (const char* fragment : {"Rays", "camera", "shadow", "% blocked", "Camera-ray hits",
-                                 "Top-level structure (brute)", "primitives tested", "Time",
-                                 "load scene", "commit", "render", "write files"}) {
+    for (const char* fragment :
+         {"Rays", "camera", "shadow", "% blocked", "Camera-ray hits", "Top-level structure (brute)",
+          "primitives tested", "Time", "load scene", "commit", "render", "write files"}) {
         EXPECT_NE(result.out.find(fragment), std::string::npos) << fragment << ": " << result.out;
     }
     // 200 camera rays at 1 spp, their count printed in the table as in the summary line.

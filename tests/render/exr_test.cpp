@@ -7,8 +7,8 @@
 #include <OpenEXR/ImfIDManifest.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfInputPart.h>
-#include <OpenEXR/ImfMultiPartInputFile.h>
 #include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
@@ -19,10 +19,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
-#include <sstream>
 #include <limits>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -101,9 +100,9 @@ TEST(WriteExr, WritesTheDocumentedChannelsAndAttributes) {
     const Imf::Header& header = file.header();
     const Imf::ChannelList& channels = header.channels();
     const std::vector<std::pair<std::string, Imf::PixelType>> expected = {
-        {"A", Imf::HALF},   {"B", Imf::HALF},    {"G", Imf::HALF},
+        {"A", Imf::HALF},    {"B", Imf::HALF},    {"G", Imf::HALF},
         {"N.X", Imf::FLOAT}, {"N.Y", Imf::FLOAT}, {"N.Z", Imf::FLOAT},
-        {"R", Imf::HALF},   {"Z", Imf::FLOAT},   {"cost", Imf::FLOAT}};
+        {"R", Imf::HALF},    {"Z", Imf::FLOAT},   {"cost", Imf::FLOAT}};
     std::vector<std::pair<std::string, Imf::PixelType>> found;
     for (auto it = channels.begin(); it != channels.end(); ++it) {
         found.emplace_back(it.name(), it.channel().type);
@@ -152,7 +151,9 @@ TEST(WriteExr, WritesTheDocumentedChannelsAndAttributes) {
     const Imf::ChannelList& id_channels = parts.header(1).channels();
     ASSERT_NE(id_channels.findChannel("id"), nullptr);
     EXPECT_EQ(id_channels.findChannel("id")->type, Imf::UINT);
-    EXPECT_EQ(std::distance(id_channels.begin(), id_channels.end()), 1);
+    int id_channel_count = 0;
+    for (auto it = id_channels.begin(); it != id_channels.end(); ++it) ++id_channel_count;
+    EXPECT_EQ(id_channel_count, 1);
     Imf::FrameBuffer id_buffer;
     id_buffer.insert("id", Imf::Slice(Imf::UINT, reinterpret_cast<char*>(id.data()),
                                       sizeof(std::uint32_t), 5 * sizeof(std::uint32_t)));
@@ -248,8 +249,8 @@ TEST(WriteExr, IdenticalImagesGiveByteIdenticalFilesWithoutTimings) {
     EXPECT_GT(a.size(), 100u);
     EXPECT_EQ(a, bytes(directory / "b.exr"));
     Imf::InputFile file((directory / "a.exr").c_str());
-    EXPECT_EQ(file.header().findAttribute("acceleratorBuildMs"), nullptr);
-    EXPECT_EQ(file.header().findAttribute("renderSeconds"), nullptr);
+    EXPECT_TRUE(file.header().find("acceleratorBuildMs") == file.header().end());
+    EXPECT_TRUE(file.header().find("renderSeconds") == file.header().end());
     EXPECT_FALSE(read_exr(directory / "a.exr").metadata.include_timing);
 
     metadata.include_timing = true;  // asked for: recorded, and read back

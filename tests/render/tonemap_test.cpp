@@ -27,7 +27,8 @@ TEST(ToneMap, ReinhardIsXOverOnePlusX) {
 TEST(ToneMap, FilmicFollowsNarkowiczsFit) {
     // The fit evaluated by hand at x = 1 (s = 0.6): 0.6 * 1.536 / (0.6 * 2.048 + 0.14).
     const double s = 0.6;
-    EXPECT_DOUBLE_EQ(tone_map(1.0, kFilmic), s * (2.51 * s + 0.03) / (s * (2.43 * s + 0.59) + 0.14));
+    EXPECT_DOUBLE_EQ(tone_map(1.0, kFilmic),
+                     s * (2.51 * s + 0.03) / (s * (2.43 * s + 0.59) + 0.14));
     EXPECT_EQ(tone_map(0.0, kFilmic), 0.0);
     EXPECT_EQ(tone_map(100.0, kFilmic), 1.0);  // the shoulder saturates
     // Monotone over the range a render produces.
