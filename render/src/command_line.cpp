@@ -183,7 +183,8 @@ void print_statistics(std::ostream& out, const Scene& scene, const RenderStats& 
     row("camera", stats.primary_rays, percent(stats.primary_hits, stats.primary_rays) + " hit");
     row("shadow", stats.shadow_rays,
         percent(stats.shadow_rays_blocked, stats.shadow_rays) + " blocked");
-    row("total", stats.primary_rays + stats.shadow_rays);
+    row("mirror and glass", stats.secondary_rays);
+    row("total", stats.primary_rays + stats.shadow_rays + stats.secondary_rays);
     out << "Camera-ray hits by the top-level object's shape\n";
     std::map<std::string, std::pair<std::size_t, std::uint64_t>> kinds;  // objects, hits
     for (std::size_t i = 0; i < scene.objects().size(); ++i) {

@@ -15,6 +15,7 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/csg/scene.h"
+#include "csgrt/render/materials.h"
 #include "csgrt/render/sampling.h"
 #include "csgrt/render/shadow_offset.h"
 
@@ -47,6 +48,7 @@ double scene_magnitude(const Scene& scene) {
 struct RayTally {
     std::uint64_t shadow_rays = 0;
     std::uint64_t shadow_rays_blocked = 0;
+    std::uint64_t secondary_rays = 0;
     std::uint64_t primary_hits = 0;
     TraversalCounters centre_ray_work;
     /// Sized to the scene's objects once per worker, so counting allocates nothing per ray.
@@ -58,17 +60,19 @@ struct RayTally {
     }
 };
 
-Vector3 albedo_of(const Scene& scene, std::uint32_t object_id) {
-    if (object_id >= scene.objects().size()) return Material{}.albedo;
+const Material& material_of(const Scene& scene, std::uint32_t object_id) {
+    static const Material kDefault;
+    if (object_id >= scene.objects().size()) return kDefault;
     const std::uint32_t material = scene.objects()[object_id].material;
-    if (material >= scene.materials().size()) return Material{}.albedo;
-    return scene.materials()[material].albedo;
+    if (material >= scene.materials().size()) return kDefault;
+    return scene.materials()[material];
 }
 
 /// Linear radiance leaving `hit` toward the camera along `ray` (unit direction).
 Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
               RayTally& tally) {
-    const Vector3 albedo = albedo_of(frame.scene, hit.object_id);
+    const Material& material = material_of(frame.scene, hit.object_id);
+    const Vector3& albedo = material.albedo;
     const Vector3 view = -ray.direction;
     // Both sides of every surface are shaded: turn the normals to the side the ray came from.
     Normal3 geometric = hit.geometric_normal;
@@ -78,11 +82,11 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
 
     if (frame.scene.lights().empty()) {
         // An eye light: without it a scene without lights would render black.
-        return albedo * std::abs(shading.dot(view));
+        return albedo * std::abs(shading.dot(view)) + albedo.cwiseProduct(frame.settings.ambient);
     }
 
     const Point3 origin = offset_ray_origin(hit.point, geometric, frame.scene_magnitude);
-    Vector3 radiance = Vector3::Zero();
+    Vector3 radiance = albedo.cwiseProduct(frame.settings.ambient);
     for (const Light& light : frame.scene.lights()) {
         Vector3 to_light;
         Vector3 irradiance;
@@ -114,6 +118,76 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
             continue;
         }
         radiance += albedo.cwiseProduct(irradiance) * (cosine / kPi);
+        if (material.specular.maxCoeff() > 0.0) {
+            const double lobe = phong_lobe(to_light, view, shading, material.shininess);
+            radiance += material.specular.cwiseProduct(irradiance) * (lobe * cosine);
+        }
+    }
+    return radiance;
+}
+
+Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
+                      RayTally& tally, int depth);
+
+/// Radiance arriving along a mirror or glass ray spawned at bounce `depth` (1 for the first).
+Vector3 trace(const Frame& frame, const Ray& ray, QueryScratch& scratch, RayTally& tally,
+              int depth) {
+    if (depth > frame.settings.max_depth) return Vector3::Zero();
+    ++tally.secondary_rays;
+    const std::optional<Hit> hit = frame.scene.intersect(ray, scratch);
+    if (!hit) return frame.settings.background;
+    return shade_surface(frame, ray, *hit, scratch, tally, depth);
+}
+
+/// A ray leaving hit.point along `direction`, on the side of `side` (the geometric normal
+/// turned to that side), from the offset origin shadow rays use.
+Ray spawned_ray(const Frame& frame, const Hit& hit, const Normal3& side, const Vector3& direction) {
+    Ray ray;
+    ray.origin = offset_ray_origin(hit.point, side, frame.scene_magnitude);
+    ray.direction = direction;
+    ray.t_max = kInfinity;
+    return ray;
+}
+
+/// The radiance leaving `hit` along -ray.direction: glass (render/materials.h) by Fresnel
+/// reflection and refraction; other materials by direct light (shade) plus mirror reflection.
+Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
+                      RayTally& tally, int depth) {
+    const Material& material = material_of(frame.scene, hit.object_id);
+    const Vector3& direction = ray.direction;
+    if (material.ior > 0.0) {
+        // The surface's own normal is outward (CSG results included), so its sign says whether
+        // the ray enters or leaves the solid.
+        const bool entering = direction.dot(hit.geometric_normal) < 0.0;
+        const Normal3 geometric = entering ? hit.geometric_normal : -hit.geometric_normal;
+        Normal3 normal = entering ? hit.shading_normal : -hit.shading_normal;
+        if (normal.dot(geometric) < 0.0) normal = geometric;
+        const double eta_incident = entering ? 1.0 : material.ior;
+        const double eta_transmitted = entering ? material.ior : 1.0;
+        const double reflectance =
+            fresnel_dielectric(-direction.dot(normal), eta_incident, eta_transmitted);
+        Vector3 radiance =
+            reflectance * trace(frame,
+                                spawned_ray(frame, hit, geometric, reflect(direction, normal)),
+                                scratch, tally, depth + 1);
+        if (reflectance < 1.0) {
+            if (const auto refracted = refract(direction, normal, eta_incident / eta_transmitted)) {
+                radiance += (1.0 - reflectance) *
+                            trace(frame, spawned_ray(frame, hit, -geometric, *refracted), scratch,
+                                  tally, depth + 1);
+            }
+        }
+        return radiance;
+    }
+    Vector3 radiance = shade(frame, ray, hit, scratch, tally);
+    if (material.mirror.maxCoeff() > 0.0 && depth < frame.settings.max_depth) {
+        const Normal3 geometric = direction.dot(hit.geometric_normal) < 0.0 ? hit.geometric_normal
+                                                                            : -hit.geometric_normal;
+        Normal3 normal = hit.shading_normal;
+        if (normal.dot(geometric) < 0.0) normal = -normal;
+        radiance += material.mirror.cwiseProduct(
+            trace(frame, spawned_ray(frame, hit, geometric, reflect(direction, normal)), scratch,
+                  tally, depth + 1));
     }
     return radiance;
 }
@@ -145,8 +219,10 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
     int covered = 0;
     if (settings.samples_per_pixel == 1) {
         if (centre_hit) {
-            colour = shade(frame, centre, *centre_hit, scratch, tally);
+            colour = shade_surface(frame, centre, *centre_hit, scratch, tally, 0);
             covered = 1;
+        } else {
+            colour = settings.background;
         }
     } else {
         SampleRandom random = pixel_random(settings.seed, x, y);
@@ -154,9 +230,12 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
             const Vector2 film = stratified_sample(frame.strata, sample, random);
             const Ray ray = frame.film.ray((x + film.x()) / width, (y + film.y()) / height);
             const std::optional<Hit> hit = frame.scene.intersect(ray, scratch);
-            if (!hit) continue;
+            if (!hit) {
+                colour += settings.background;
+                continue;
+            }
             tally.count_hit(hit->object_id);
-            colour += shade(frame, ray, *hit, scratch, tally);
+            colour += shade_surface(frame, ray, *hit, scratch, tally, 0);
             ++covered;
         }
     }
@@ -180,6 +259,12 @@ void validate(const RenderSettings& settings) {
     require(settings.threads >= 0, "RenderSettings", "threads", ">= 0 (0: all cores)",
             settings.threads);
     require(settings.tile_size >= 1, "RenderSettings", "tile_size", ">= 1", settings.tile_size);
+    require(settings.max_depth >= 0 && settings.max_depth <= kMaxTraceDepth, "RenderSettings",
+            "max_depth", "in [0, " + std::to_string(kMaxTraceDepth) + "]", settings.max_depth);
+    require(settings.background.allFinite() && (settings.background.array() >= 0.0).all(),
+            "RenderSettings", "background", "finite and >= 0", settings.background);
+    require(settings.ambient.allFinite() && (settings.ambient.array() >= 0.0).all(),
+            "RenderSettings", "ambient", "finite and >= 0", settings.ambient);
 }
 
 RenderResult render(const Scene& scene, const RenderSettings& settings) {
@@ -240,6 +325,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
     for (const RayTally& tally : tallies) {
         result.stats.shadow_rays += tally.shadow_rays;
         result.stats.shadow_rays_blocked += tally.shadow_rays_blocked;
+        result.stats.secondary_rays += tally.secondary_rays;
         result.stats.primary_hits += tally.primary_hits;
         result.stats.centre_ray_work.nodes_visited += tally.centre_ray_work.nodes_visited;
         result.stats.centre_ray_work.primitives_tested += tally.centre_ray_work.primitives_tested;
