@@ -847,6 +847,11 @@ void Loader::lights(Scene& scene) {
             light.position = fields.vector("position");
             light.intensity = fields.colour("intensity", light.intensity);
             check_colour("intensity", light.intensity);
+            light.falloff = fields.number("falloff", light.falloff);
+            if (!(light.falloff >= 0.0 && light.falloff <= 4.0)) {
+                fields.fail("falloff", "expected an exponent in [0, 4] (2: 1/d^2), got " +
+                                           detail::describe(light.falloff));
+            }
             scene.add_light(light);
         } else if (type == "directional") {
             fields.set_what("a directional light");

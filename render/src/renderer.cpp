@@ -97,7 +97,10 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
             const double distance_squared = offset.squaredNorm();
             if (!(distance_squared > 0.0)) continue;
             to_light = offset / std::sqrt(distance_squared);
-            irradiance = point->intensity / distance_squared;
+            irradiance =
+                point->falloff == 2.0
+                    ? Vector3(point->intensity / distance_squared)
+                    : Vector3(point->intensity / std::pow(distance_squared, 0.5 * point->falloff));
             // Up to the light, stopping short of it by the same relative margin the origin
             // keeps from the surface, so a light lying on a surface is not hidden by it.
             shadow.direction = point->position - origin;

@@ -175,6 +175,41 @@ TEST(Ambient, AddsAlbedoTimesAmbientUnshadowed) {
     EXPECT_THROW(render(scene, settings), InvalidParameter);
 }
 
+TEST(PointLight, FallsOffWithTheChosenPowerOfDistance) {
+    // A white Lambert plane z = 0 facing a light on its normal at height h, seen head on:
+    // radiance = albedo / pi * I / h^k. Two heights give the ratio (h2 / h1)^k.
+    auto seen_at = [](double height, double falloff) {
+        Scene scene;
+        const auto white = scene.add_material(Material{"white", Vector3::Constant(1.0)});
+        scene.add_object(std::make_shared<Plane>(Point3(0, 0, 0), Normal3(0, 0, 1)), white);
+        PointLight light{Point3(0, 0, height), Vector3::Constant(1.0)};
+        light.falloff = falloff;
+        scene.add_light(light);
+        Camera camera;
+        camera.position = Point3(0, 0, 1);
+        camera.look_at = Point3(0, 0, 0);
+        scene.set_camera(camera);
+        scene.commit();
+        return centre_pixel(scene, RenderSettings{}).x();
+    };
+    for (double falloff : {0.0, 1.0, 2.0}) {
+        // Float pixels: 1e-6 relative.
+        EXPECT_NEAR(seen_at(2.0, falloff), 1.0 / kPi / std::pow(2.0, falloff), 1e-6) << falloff;
+        EXPECT_NEAR(seen_at(2.0, falloff) / seen_at(4.0, falloff), std::pow(2.0, falloff), 1e-5)
+            << falloff;
+    }
+    try {
+        load_scene_from_string(
+            R"({"objects": [], "lights": [{"type": "point", "position": [0, 1, 0], "falloff": 7}]})",
+            "light.json");
+        ADD_FAILURE() << "no error";
+    } catch (const std::exception& error) {
+        EXPECT_NE(std::string(error.what()).find("light.json: /lights/0/falloff: expected"),
+                  std::string::npos)
+            << error.what();
+    }
+}
+
 TEST(MaterialKeys, TheSceneFileReadsAndChecksThem) {
     const std::string head = R"({"objects": [], "materials": {"m": {"albedo": 0.2, )";
     const Scene scene = load_scene_from_string(

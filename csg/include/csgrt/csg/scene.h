@@ -34,6 +34,9 @@ struct PointLight {
     Point3 position{0.0, 10.0, 0.0};
     /// Linear RGB intensity (radiance times squared distance).
     Vector3 intensity{100.0, 100.0, 100.0};
+    /// The exponent k of the falloff, irradiance = intensity / distance^k: 2 is physical;
+    /// 1 and 0 match renderers whose lights fade linearly or not at all.
+    double falloff = 2.0;
 };
 
 /// Light from infinitely far away, arriving along `direction` (the way the light travels).
