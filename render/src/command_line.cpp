@@ -392,10 +392,12 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
     CLI::App* render = app.add_subcommand("render", "Render a scene to an EXR with PNG previews");
     render->footer(
         "Writes OUT.exr with the channels R G B A (half, linear, premultiplied), Z (distance\n"
-        "along the centre camera ray; inf for background), N.X N.Y N.Z (world normal), id\n"
-        "(object index; 4294967295 for background) and cost (structure nodes visited plus\n"
-        "primitives tested), and beside it OUT.png (colour, sRGB, clamped) and OUT.cost.png\n"
-        "(cost in false colour). Prints one summary line: time, Mrays/s, the structure.");
+        "along the centre camera ray; inf for background), N.X N.Y N.Z (world normal) and cost\n"
+        "(structure nodes visited plus primitives tested) in its part \"rgba\", and id (uint\n"
+        "object index; 4294967295 for background, named by the idManifest) in its part \"id\";\n"
+        "beside it OUT.png (colour, tone mapped by --tonemap, sRGB) and OUT.cost.png (cost in\n"
+        "false colour, with a scale). Prints one summary line: time, Mrays/s, the structure;\n"
+        "--stats adds a table of rays, hits, the structure's work and time per stage.");
     render->add_option("scene", options.scene, "The JSON scene file")
         ->required()
         ->type_name("SCENE.json");
