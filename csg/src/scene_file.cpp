@@ -798,6 +798,25 @@ void Loader::materials(Scene& scene, std::map<std::string, std::uint32_t>& by_na
         }
         Fields fields(it.value(), at, source_, "a material");
         Material material{it.key(), fields.colour("albedo", Vector3(0.8, 0.8, 0.8))};
+        // Secondary-ray terms (render/materials.h, docs/scene-format.md): each checked here.
+        material.specular = fields.colour("specular", material.specular);
+        material.mirror = fields.colour("mirror", material.mirror);
+        for (const char* key : {"specular", "mirror"}) {
+            const Vector3& colour = key[0] == 's' ? material.specular : material.mirror;
+            if (!((colour.array() >= 0.0) && (colour.array() <= 1.0)).all()) {
+                fields.fail(key, "expected values in [0, 1], got " + detail::describe(colour));
+            }
+        }
+        material.shininess = fields.number("shininess", material.shininess);
+        if (!(material.shininess >= 0.0 && material.shininess <= 1e6)) {
+            fields.fail("shininess", "expected a Phong exponent in [0, 1e6], got " +
+                                         detail::describe(material.shininess));
+        }
+        material.ior = fields.number("ior", material.ior);
+        if (!(material.ior == 0.0 || (material.ior >= 1.0 && material.ior <= 10.0))) {
+            fields.fail("ior", "expected 0 (opaque) or an index of refraction in [1, 10], got " +
+                                   detail::describe(material.ior));
+        }
         fields.finish();
         try {
             by_name[it.key()] = scene.add_material(material);
@@ -828,6 +847,11 @@ void Loader::lights(Scene& scene) {
             light.position = fields.vector("position");
             light.intensity = fields.colour("intensity", light.intensity);
             check_colour("intensity", light.intensity);
+            light.falloff = fields.number("falloff", light.falloff);
+            if (!(light.falloff >= 0.0 && light.falloff <= 4.0)) {
+                fields.fail("falloff", "expected an exponent in [0, 4] (2: 1/d^2), got " +
+                                           detail::describe(light.falloff));
+            }
             scene.add_light(light);
         } else if (type == "directional") {
             fields.set_what("a directional light");

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -14,6 +15,7 @@
 #include <string>
 
 #include "csgrt/accel/mesh.h"
+#include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/compound.h"
@@ -21,6 +23,7 @@
 #include "csgrt/csg/scene_file.h"
 #include "csgrt/render/exr.h"
 #include "csgrt/render/renderer.h"
+#include "csgrt/render/tonemap.h"
 
 namespace csgrt {
 
@@ -149,7 +152,63 @@ struct RenderOptions {
     int samples_per_pixel = 1;
     int threads = 0;
     std::string accelerator = "auto";
+    std::string tone_curve = "filmic";
+    double exposure_stops = 0.0;
+    bool timing_in_header = false;
+    bool statistics = false;
 };
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The --stats table, after POV-Ray's end-of-render statistics: rays by kind, hits by the
+/// top-level objects' shape kinds, the top-level structure's work, time per stage.
+void print_statistics(std::ostream& out, const Scene& scene, const RenderStats& stats,
+                      const std::array<double, 4>& stage_seconds) {
+    auto row = [&out](const char* label, std::uint64_t count, const std::string& note = {}) {
+        char line[160];
+        std::snprintf(line, sizeof(line), "  %-28s %14llu  %s", label,
+                      static_cast<unsigned long long>(count), note.c_str());
+        std::string text = line;
+        while (!text.empty() && text.back() == ' ') text.pop_back();
+        out << text << '\n';
+    };
+    auto percent = [](std::uint64_t part, std::uint64_t whole) {
+        char text[32];
+        std::snprintf(text, sizeof(text), "%.1f%%", whole ? 100.0 * part / whole : 0.0);
+        return std::string(text);
+    };
+    out << "Rays\n";
+    row("camera", stats.primary_rays, percent(stats.primary_hits, stats.primary_rays) + " hit");
+    row("shadow", stats.shadow_rays,
+        percent(stats.shadow_rays_blocked, stats.shadow_rays) + " blocked");
+    row("mirror and glass", stats.secondary_rays);
+    row("total", stats.primary_rays + stats.shadow_rays + stats.secondary_rays);
+    out << "Camera-ray hits by the top-level object's shape\n";
+    std::map<std::string, std::pair<std::size_t, std::uint64_t>> kinds;  // objects, hits
+    for (std::size_t i = 0; i < scene.objects().size(); ++i) {
+        auto& kind = kinds[std::string(scene.objects()[i].shape->kind())];
+        ++kind.first;
+        if (i < stats.hits_per_object.size()) kind.second += stats.hits_per_object[i];
+    }
+    for (const auto& [kind, count] : kinds) {
+        row(kind.c_str(), count.second,
+            std::to_string(count.first) + (count.first == 1 ? " object" : " objects"));
+    }
+    out << "Top-level structure (" << scene.accelerator_name() << "), centre rays\n";
+    row("nodes or cells visited", stats.centre_ray_work.nodes_visited);
+    row("primitives tested", stats.centre_ray_work.primitives_tested);
+    row("boxes tested", stats.centre_ray_work.boxes_tested);
+    out << "Time\n";
+    const std::array<const char*, 4> stages = {"load scene", "commit (build structures)", "render",
+                                               "write files"};
+    for (std::size_t i = 0; i < stages.size(); ++i) {
+        char line[96];
+        std::snprintf(line, sizeof(line), "  %-28s %14.3f s\n", stages[i], stage_seconds[i]);
+        out << line;
+    }
+}
 
 void render_command(const RenderOptions& options, CommandLineStreams streams) {
     check_range("--width", options.width, 1, kMaxImageSize);
@@ -157,13 +216,29 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
     check_range("--spp", options.samples_per_pixel, 1, kMaxSamplesPerPixel);
     check_range("--threads", options.threads, 0, 1024);
     check_structure(options.accelerator);
+    ToneMapping tone_mapping;
+    try {
+        tone_mapping.curve = parse_tone_curve(options.tone_curve);
+    } catch (const InvalidParameter&) {
+        throw UsageError("--tonemap " + options.tone_curve +
+                         ": unknown curve (available: filmic, reinhard, clamp)");
+    }
+    if (!std::isfinite(options.exposure_stops) || std::abs(options.exposure_stops) > 64.0) {
+        throw UsageError("--exposure must be in [-64, 64] stops");
+    }
+    tone_mapping.exposure_stops = options.exposure_stops;
     const fs::path output = options.output;
     check_output_path(output);
 
+    std::array<double, 4> stage_seconds{};  // load, commit, render, write
+    Clock::time_point stage_start = Clock::now();
     Scene scene = load_checked(options.scene);
+    stage_seconds[0] = seconds_since(stage_start);
+    stage_start = Clock::now();
     SceneConfig config;
     config.accelerator = options.accelerator;
     scene.commit(config);
+    stage_seconds[1] = seconds_since(stage_start);
 
     RenderSettings settings;
     settings.width = options.width;
@@ -182,7 +257,13 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
     metadata.accelerator_build_milliseconds = structure.build_milliseconds;
     metadata.samples_per_pixel = options.samples_per_pixel;
     metadata.scene = fs::path(options.scene).filename().string();
-    write_render_files(output, result.image, metadata);
+    metadata.include_timing = options.timing_in_header;
+    metadata.render_seconds = result.stats.seconds;
+    metadata.objects = exr_objects(scene);
+    stage_start = Clock::now();
+    write_render_files(output, result.image, metadata, tone_mapping);
+    stage_seconds[2] = result.stats.seconds;
+    stage_seconds[3] = seconds_since(stage_start);
 
     std::ostringstream summary;
     summary.setf(std::ios::fixed);
@@ -197,6 +278,7 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
     summary << structure.build_milliseconds << " ms; wrote " << output.string() << ", "
             << colour_preview_path(output).string() << ", " << cost_preview_path(output).string();
     streams.out << summary.str() << '\n';
+    if (options.statistics) print_statistics(streams.out, scene, result.stats, stage_seconds);
 }
 
 /// Counts every shape in the tree under `shape` by kind(), descending through instances,
@@ -310,10 +392,12 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
     CLI::App* render = app.add_subcommand("render", "Render a scene to an EXR with PNG previews");
     render->footer(
         "Writes OUT.exr with the channels R G B A (half, linear, premultiplied), Z (distance\n"
-        "along the centre camera ray; inf for background), N.X N.Y N.Z (world normal), id\n"
-        "(object index; 4294967295 for background) and cost (structure nodes visited plus\n"
-        "primitives tested), and beside it OUT.png (colour, sRGB, clamped) and OUT.cost.png\n"
-        "(cost in false colour). Prints one summary line: time, Mrays/s, the structure.");
+        "along the centre camera ray; inf for background), N.X N.Y N.Z (world normal) and cost\n"
+        "(structure nodes visited plus primitives tested) in its part \"rgba\", and id (uint\n"
+        "object index; 4294967295 for background, named by the idManifest) in its part \"id\";\n"
+        "beside it OUT.png (colour, tone mapped by --tonemap, sRGB) and OUT.cost.png (cost in\n"
+        "false colour, with a scale). Prints one summary line: time, Mrays/s, the structure;\n"
+        "--stats adds a table of rays, hits, the structure's work and time per stage.");
     render->add_option("scene", options.scene, "The JSON scene file")
         ->required()
         ->type_name("SCENE.json");
@@ -341,6 +425,23 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
                          " ('csgrt info' shows what auto picks)")
         ->capture_default_str()
         ->type_name("NAME");
+    render
+        ->add_option("--tonemap", options.tone_curve,
+                     "The PNG preview's tone curve: filmic (ACES fit), reinhard (x/(1+x)) or "
+                     "clamp; the EXR stays linear")
+        ->capture_default_str()
+        ->type_name("CURVE");
+    render
+        ->add_option("--exposure", options.exposure_stops,
+                     "Stops of exposure applied before the PNG's tone curve (linear * 2^EV)")
+        ->capture_default_str()
+        ->type_name("EV");
+    render->add_flag("--timing-in-header", options.timing_in_header,
+                     "Record acceleratorBuildMs and renderSeconds in the EXR header (files of "
+                     "identical renders then differ)");
+    render->add_flag("--stats", options.statistics,
+                     "Print a statistics table after the summary: rays by kind, hits by shape "
+                     "kind, the structure's work, time per stage");
 
     std::string scene_path;
     CLI::App* info = app.add_subcommand("info", "Describe a scene and the structure 'auto' builds");

@@ -5,9 +5,13 @@
 #include <OpenEXR/ImfDoubleAttribute.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfIDManifest.h>
+#include <OpenEXR/ImfInputPart.h>
 #include <OpenEXR/ImfIntAttribute.h>
-#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfMultiPartOutputFile.h>
+#include <OpenEXR/ImfOutputPart.h>
+#include <OpenEXR/ImfPartType.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
@@ -22,6 +26,7 @@
 #include <system_error>
 #include <vector>
 
+#include "csgrt/csg/scene.h"
 #include "csgrt/render/png.h"
 
 namespace csgrt {
@@ -67,25 +72,33 @@ private:
 
 struct ChannelSpec {
     const char* name;
+    /// The part it is written to: 0 (kImagePart) or 1 (kIdPart).
+    int part;
     Imf::PixelType file_type;
     Imf::PixelType memory_type;
     std::size_t offset;
     double fill;
 };
 
-// The channels in file order, with where each lives in a Pixel and what a missing one reads as;
-// the half channels come first, in the order of the write buffer.
+constexpr int kImagePart = 0;
+constexpr int kIdPart = 1;
+const std::array<const char*, 2> kPartNames = {"rgba", "id"};
+
+// The channels in file order, with their part, where each lives in a Pixel and what a missing
+// one reads as; the half channels come first, in the order of the write buffer. The id has a
+// part of its own: OpenImageIO gives a part one pixel type, and in a part of mixed types it
+// converts a uint channel to float normalised by 2^32 - 1, which loses the ids.
 const std::array<ChannelSpec, 10> kChannels = {{
-    {"R", Imf::HALF, Imf::FLOAT, offsetof(Pixel, red), 0.0},
-    {"G", Imf::HALF, Imf::FLOAT, offsetof(Pixel, green), 0.0},
-    {"B", Imf::HALF, Imf::FLOAT, offsetof(Pixel, blue), 0.0},
-    {"A", Imf::HALF, Imf::FLOAT, offsetof(Pixel, alpha), 0.0},
-    {"Z", Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, depth), kInfinity},
-    {"N.X", Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_x), 0.0},
-    {"N.Y", Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_y), 0.0},
-    {"N.Z", Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_z), 0.0},
-    {"id", Imf::UINT, Imf::UINT, offsetof(Pixel, object_id), double(kNoIndex)},
-    {"cost", Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost), 0.0},
+    {"R", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, red), 0.0},
+    {"G", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, green), 0.0},
+    {"B", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, blue), 0.0},
+    {"A", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, alpha), 0.0},
+    {"Z", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, depth), kInfinity},
+    {"N.X", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_x), 0.0},
+    {"N.Y", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_y), 0.0},
+    {"N.Z", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_z), 0.0},
+    {"cost", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost), 0.0},
+    {"id", kIdPart, Imf::UINT, Imf::UINT, offsetof(Pixel, object_id), double(kNoIndex)},
 }};
 
 Imath::V3d to_imath(const Vector3& v) {
@@ -110,13 +123,34 @@ Imath::M44f world_to_camera(const Camera& camera) {
     return matrix;
 }
 
+/// The idManifest of the id part: one entry per scene object, id -> (name, shape, material).
+Imf::IDManifest id_manifest(const ExrMetadata& metadata) {
+    Imf::IDManifest manifest;
+    Imf::IDManifest::ChannelGroupManifest& group = manifest.add("id");
+    group.setComponents({"name", "shape", "material"});
+    // Ids are indices into the scene's objects: they change when the scene file does.
+    group.setLifetime(Imf::IDManifest::LIFETIME_SHOT);
+    group.setHashScheme(Imf::IDManifest::NOTHASHED);
+    group.setEncodingScheme(Imf::IDManifest::ID_SCHEME);
+    for (std::size_t id = 0; id < metadata.objects.size(); ++id) {
+        const ExrObject& object = metadata.objects[id];
+        group.insert(id, std::vector<std::string>{object.name, object.shape, object.material});
+    }
+    return manifest;
+}
+
 void write_exr_file(const std::filesystem::path& path, const Image& image,
                     const ExrMetadata& metadata) {
-    Imf::Header header(image.width(), image.height());
-    header.compression() = Imf::ZIP_COMPRESSION;
-    for (const ChannelSpec& channel : kChannels) {
-        header.channels().insert(channel.name, Imf::Channel(channel.file_type));
+    std::vector<Imf::Header> headers(kPartNames.size(), Imf::Header(image.width(), image.height()));
+    for (std::size_t part = 0; part < headers.size(); ++part) {
+        headers[part].setName(kPartNames[part]);
+        headers[part].setType(Imf::SCANLINEIMAGE);
+        headers[part].compression() = Imf::ZIP_COMPRESSION;
     }
+    for (const ChannelSpec& channel : kChannels) {
+        headers[channel.part].channels().insert(channel.name, Imf::Channel(channel.file_type));
+    }
+    Imf::Header& header = headers[kImagePart];
     header.insert("resolution", Imf::V2iAttribute(Imath::V2i(image.width(), image.height())));
     const Camera& camera = metadata.camera;
     const bool pinhole = camera.projection == Camera::Projection::Pinhole;
@@ -131,10 +165,15 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
     }
     Imf::addWorldToCamera(header, world_to_camera(camera));
     header.insert("accelerator", Imf::StringAttribute(metadata.accelerator));
-    header.insert("acceleratorBuildMs",
-                  Imf::DoubleAttribute(metadata.accelerator_build_milliseconds));
+    // Timings differ from run to run: only when asked, so identical renders give identical files.
+    if (metadata.include_timing) {
+        header.insert("acceleratorBuildMs",
+                      Imf::DoubleAttribute(metadata.accelerator_build_milliseconds));
+        header.insert("renderSeconds", Imf::DoubleAttribute(metadata.render_seconds));
+    }
     header.insert("samplesPerPixel", Imf::IntAttribute(metadata.samples_per_pixel));
     header.insert("scene", Imf::StringAttribute(metadata.scene));
+    Imf::addIDManifest(headers[kIdPart], Imf::CompressedIDManifest(id_manifest(metadata)));
 
     // OpenEXR converts pixel types when reading but not when writing: the colour channels go
     // through a half buffer (R, G, B, A interleaved).
@@ -143,12 +182,13 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
         const Pixel& pixel = image.pixels()[i];
         colour[i] = {half(pixel.red), half(pixel.green), half(pixel.blue), half(pixel.alpha)};
     }
-    Imf::FrameBuffer frame_buffer;
+    std::vector<Imf::FrameBuffer> frame_buffers(kPartNames.size());
     const char* base = reinterpret_cast<const char*>(image.pixels().data());
     const std::size_t row = sizeof(Pixel) * static_cast<std::size_t>(image.width());
     const std::size_t colour_row = sizeof(colour[0]) * static_cast<std::size_t>(image.width());
     for (std::size_t c = 0; c < kChannels.size(); ++c) {
         const ChannelSpec& channel = kChannels[c];
+        Imf::FrameBuffer& frame_buffer = frame_buffers[channel.part];
         if (channel.file_type == Imf::HALF) {
             char* channel_base = reinterpret_cast<char*>(colour.data()) + c * sizeof(half);
             frame_buffer.insert(channel.name,
@@ -159,9 +199,12 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
                                                          sizeof(Pixel), row));
         }
     }
-    Imf::OutputFile file(path.c_str(), header);
-    file.setFrameBuffer(frame_buffer);
-    file.writePixels(image.height());
+    Imf::MultiPartOutputFile file(path.c_str(), headers.data(), static_cast<int>(headers.size()));
+    for (std::size_t part = 0; part < headers.size(); ++part) {
+        Imf::OutputPart output(file, static_cast<int>(part));
+        output.setFrameBuffer(frame_buffers[part]);
+        output.writePixels(image.height());
+    }
 }
 
 template <class Attribute, class Value>
@@ -185,20 +228,30 @@ void write_exr(const std::filesystem::path& path, const Image& image, const ExrM
 
 ExrFile read_exr(const std::filesystem::path& path) {
     try {
-        Imf::InputFile file(path.c_str());
-        const Imf::Header& header = file.header();
+        Imf::MultiPartInputFile file(path.c_str());
+        // Earlier csgrt files are one part; the channels are looked up by name in every part.
+        const Imf::Header& header = file.header(0);
         const Imath::Box2i window = header.dataWindow();
         ExrFile result{Image(window.max.x - window.min.x + 1, window.max.y - window.min.y + 1), {}};
-        Imf::FrameBuffer frame_buffer;
         char* base = reinterpret_cast<char*>(result.image.pixels().data());
         const std::size_t row = sizeof(Pixel) * static_cast<std::size_t>(result.image.width());
-        for (const ChannelSpec& channel : kChannels) {
-            frame_buffer.insert(channel.name,
-                                Imf::Slice::Make(channel.memory_type, base + channel.offset, window,
-                                                 sizeof(Pixel), row, 1, 1, channel.fill));
+        std::vector<bool> found(kChannels.size(), false);
+        for (int part = 0; part < file.parts(); ++part) {
+            if (file.header(part).dataWindow() != window) continue;
+            Imf::FrameBuffer frame_buffer;
+            for (std::size_t c = 0; c < kChannels.size(); ++c) {
+                const ChannelSpec& channel = kChannels[c];
+                if (found[c] || !file.header(part).channels().findChannel(channel.name)) continue;
+                found[c] = true;
+                frame_buffer.insert(channel.name,
+                                    Imf::Slice::Make(channel.memory_type, base + channel.offset,
+                                                     window, sizeof(Pixel), row));
+            }
+            Imf::InputPart input(file, part);
+            input.setFrameBuffer(frame_buffer);
+            input.readPixels(window.min.y, window.max.y);
         }
-        file.setFrameBuffer(frame_buffer);
-        file.readPixels(window.min.y, window.max.y);
+        // Channels no part has keep Pixel's defaults, which the Image already holds.
 
         ExrMetadata& metadata = result.metadata;
         std::string projection;
@@ -219,14 +272,48 @@ ExrFile read_exr(const std::filesystem::path& path) {
         read_attribute<Imf::DoubleAttribute>(header, "cameraOrthographicHeight",
                                              metadata.camera.orthographic_height);
         read_attribute<Imf::StringAttribute>(header, "accelerator", metadata.accelerator);
+        metadata.include_timing =
+            header.findTypedAttribute<Imf::DoubleAttribute>("acceleratorBuildMs") != nullptr;
         read_attribute<Imf::DoubleAttribute>(header, "acceleratorBuildMs",
                                              metadata.accelerator_build_milliseconds);
+        read_attribute<Imf::DoubleAttribute>(header, "renderSeconds", metadata.render_seconds);
         read_attribute<Imf::IntAttribute>(header, "samplesPerPixel", metadata.samples_per_pixel);
         read_attribute<Imf::StringAttribute>(header, "scene", metadata.scene);
+        for (int part = 0; part < file.parts(); ++part) {
+            if (!Imf::hasIDManifest(file.header(part))) continue;
+            const Imf::IDManifest manifest(Imf::idManifest(file.header(part)));
+            const std::size_t group = manifest.find("id");
+            if (group >= manifest.size()) continue;
+            for (auto entry = manifest[group].begin(); entry != manifest[group].end(); ++entry) {
+                const std::vector<std::string>& text = entry.text();
+                if (entry.id() >= kNoIndex) continue;
+                if (metadata.objects.size() <= entry.id()) metadata.objects.resize(entry.id() + 1);
+                ExrObject& object = metadata.objects[entry.id()];
+                if (text.size() > 0) object.name = text[0];
+                if (text.size() > 1) object.shape = text[1];
+                if (text.size() > 2) object.material = text[2];
+            }
+        }
         return result;
     } catch (const std::exception& error) {
         throw std::runtime_error("cannot read '" + path.string() + "': " + error.what());
     }
+}
+
+std::vector<ExrObject> exr_objects(const Scene& scene) {
+    std::vector<ExrObject> objects;
+    objects.reserve(scene.objects().size());
+    for (std::size_t i = 0; i < scene.objects().size(); ++i) {
+        const SceneObject& object = scene.objects()[i];
+        ExrObject entry;
+        entry.name = object.name.empty() ? "object " + std::to_string(i) : object.name;
+        entry.shape = std::string(object.shape->kind());
+        if (object.material < scene.materials().size()) {
+            entry.material = scene.materials()[object.material].name;
+        }
+        objects.push_back(std::move(entry));
+    }
+    return objects;
 }
 
 std::filesystem::path colour_preview_path(const std::filesystem::path& exr_path) {
@@ -240,7 +327,7 @@ std::filesystem::path cost_preview_path(const std::filesystem::path& exr_path) {
 }
 
 void write_render_files(const std::filesystem::path& exr_path, const Image& image,
-                        const ExrMetadata& metadata) {
+                        const ExrMetadata& metadata, const ToneMapping& tone_mapping) {
     // A target that is a directory would fail only at its rename, after the others had been
     // replaced: check all three first.
     for (const auto& target :
@@ -254,7 +341,7 @@ void write_render_files(const std::filesystem::path& exr_path, const Image& imag
     TemporaryFile cost(cost_preview_path(exr_path));
     try {
         write_exr_file(exr.path(), image, metadata);
-        write_colour_png(colour.path(), image);
+        write_colour_png(colour.path(), image, tone_mapping);
         write_cost_png(cost.path(), image);
     } catch (const std::exception& error) {
         throw std::runtime_error("cannot write '" + exr_path.string() + "': " + error.what());

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -57,30 +58,168 @@ Vector3 viridis(double t) {
     return value.cwiseMax(0.0).cwiseMin(1.0);
 }
 
-void write_colour_png(const std::filesystem::path& path, const Image& image) {
+void write_colour_png(const std::filesystem::path& path, const Image& image,
+                      const ToneMapping& mapping) {
     std::vector<std::uint8_t> rgb;
     rgb.reserve(3 * image.pixel_count());
     for (const Pixel& pixel : image.pixels()) {
-        rgb.push_back(encode_srgb8(pixel.red));
-        rgb.push_back(encode_srgb8(pixel.green));
-        rgb.push_back(encode_srgb8(pixel.blue));
+        rgb.push_back(encode_srgb8(tone_map(pixel.red, mapping)));
+        rgb.push_back(encode_srgb8(tone_map(pixel.green, mapping)));
+        rgb.push_back(encode_srgb8(tone_map(pixel.blue, mapping)));
     }
     write_rgb8(path, image.width(), image.height(), rgb);
+}
+
+namespace {
+
+/// A 5 x 7 pixel font for the scale's numbers: each glyph is 7 rows of 5 bits, the high bit left.
+struct Glyph {
+    char character;
+    std::array<std::uint8_t, 7> rows;
+};
+
+constexpr std::array<Glyph, 13> kGlyphs = {{
+    {'0', {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}},
+    {'1', {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E}},
+    {'2', {0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F}},
+    {'3', {0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E}},
+    {'4', {0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02}},
+    {'5', {0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E}},
+    {'6', {0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E}},
+    {'7', {0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08}},
+    {'8', {0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E}},
+    {'9', {0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C}},
+    {'.', {0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C}},
+    {'k', {0x10, 0x10, 0x12, 0x14, 0x18, 0x14, 0x12}},
+    {'M', {0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11}},
+}};
+
+/// An RGB8 canvas that clips what is drawn outside it.
+struct Canvas {
+    int width;
+    int height;
+    std::vector<std::uint8_t>& rgb;
+
+    void set(int x, int y, const std::array<std::uint8_t, 3>& colour) {
+        if (x < 0 || y < 0 || x >= width || y >= height) return;
+        const std::size_t at = 3 * (static_cast<std::size_t>(y) * width + x);
+        for (int c = 0; c < 3; ++c) rgb[at + c] = colour[c];
+    }
+    void fill(int x0, int y0, int x1, int y1, const std::array<std::uint8_t, 3>& colour) {
+        for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; ++x) set(x, y, colour);
+        }
+    }
+    /// `text` with its top-left corner at (x, y), each font pixel `scale` x `scale`.
+    void text(int x, int y, const std::string& text, int scale,
+              const std::array<std::uint8_t, 3>& colour) {
+        for (char character : text) {
+            for (const Glyph& glyph : kGlyphs) {
+                if (glyph.character != character) continue;
+                for (int row = 0; row < 7; ++row) {
+                    for (int column = 0; column < 5; ++column) {
+                        if (!(glyph.rows[row] & (0x10 >> column))) continue;
+                        fill(x + column * scale, y + row * scale, x + (column + 1) * scale,
+                             y + (row + 1) * scale, colour);
+                    }
+                }
+            }
+            x += 6 * scale;
+        }
+    }
+};
+
+std::array<std::uint8_t, 3> viridis8(double t) {
+    const Vector3 colour = viridis(t);
+    return {static_cast<std::uint8_t>(std::lround(colour.x() * 255.0)),
+            static_cast<std::uint8_t>(std::lround(colour.y() * 255.0)),
+            static_cast<std::uint8_t>(std::lround(colour.z() * 255.0))};
+}
+
+/// The scale's font pixel size: 1 up to 511 pixels wide, growing with wider images.
+int scale_unit(int width) {
+    return std::max(1, width / 512 + 1);
+}
+
+}  // namespace
+
+int cost_scale_height(int width) {
+    // Margin 3, bar 10, tick 3, gap 1, numbers 7, margin 3 (font pixels).
+    return 27 * scale_unit(width);
+}
+
+std::string cost_label(double value) {
+    if (!(value > 0.0)) return "0";
+    char text[32];
+    const char* suffix = "";
+    if (value >= 1e6) {
+        value /= 1e6;
+        suffix = "M";
+    } else if (value >= 1e4) {
+        value /= 1e3;
+        suffix = "k";
+    }
+    if (value >= 100.0 && suffix[0] == '\0') {
+        std::snprintf(text, sizeof(text), "%.0f", value);
+    } else {
+        std::snprintf(text, sizeof(text), "%.3g%s", value, suffix);
+    }
+    return text;
 }
 
 void write_cost_png(const std::filesystem::path& path, const Image& image) {
     float max_cost = 0.0f;
     for (const Pixel& pixel : image.pixels()) max_cost = std::max(max_cost, pixel.cost);
-    std::vector<std::uint8_t> rgb;
-    rgb.reserve(3 * image.pixel_count());
-    for (const Pixel& pixel : image.pixels()) {
-        const double t = max_cost > 0.0f ? double(pixel.cost) / max_cost : 0.0;
-        const Vector3 colour = viridis(t);
-        for (int channel = 0; channel < 3; ++channel) {
-            rgb.push_back(static_cast<std::uint8_t>(std::lround(colour[channel] * 255.0)));
+    const int width = image.width();
+    const int strip = cost_scale_height(width);
+    const int height = image.height() + strip;
+    std::vector<std::uint8_t> rgb(3 * static_cast<std::size_t>(width) * height, 0);
+    Canvas canvas{width, height, rgb};
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < width; ++x) {
+            const float cost = image.at(x, y).cost;
+            canvas.set(x, y, viridis8(max_cost > 0.0f ? double(cost) / max_cost : 0.0));
         }
     }
-    write_rgb8(path, image.width(), image.height(), rgb);
+
+    // The scale: a dark strip, the bar from 0 (left) to the largest cost (right), five ticks
+    // with their numbers, the outer two aligned to the bar's ends so that they stay in frame.
+    const int unit = scale_unit(width);
+    const std::array<std::uint8_t, 3> dark = {24, 24, 24};
+    const std::array<std::uint8_t, 3> white = {235, 235, 235};
+    const int top = image.height();
+    canvas.fill(0, top, width, height, dark);
+    const int margin = std::min(3 * unit, std::max(0, (width - 2) / 2));
+    const int bar_left = margin;
+    const int bar_right = width - margin;  // exclusive
+    const int bar_top = top + 3 * unit;
+    for (int x = bar_left; x < bar_right; ++x) {
+        const double t =
+            bar_right - bar_left > 1 ? double(x - bar_left) / (bar_right - bar_left - 1) : 0.0;
+        canvas.fill(x, bar_top, x + 1, bar_top + 10 * unit, viridis8(t));
+    }
+    const int tick_top = bar_top + 10 * unit;
+    const int text_top = tick_top + 4 * unit;
+    // The ends first, then the middle, then the quarters: a number that would overlap one
+    // already written (a narrow image) is left out, its tick kept.
+    std::vector<std::pair<int, int>> written;
+    for (int k : {0, 4, 2, 1, 3}) {
+        const int x = bar_left + (bar_right - 1 - bar_left) * k / 4;
+        canvas.fill(x - (unit - 1) / 2, tick_top, x + unit / 2 + 1, tick_top + 3 * unit, white);
+        const std::string label = cost_label(max_cost * k / 4.0);
+        const int text_width = static_cast<int>(label.size()) * 6 * unit - unit;
+        int text_left = x - text_width / 2;
+        if (k == 0) text_left = bar_left;
+        if (k == 4) text_left = bar_right - text_width;
+        const int text_right = text_left + text_width;
+        const bool overlaps = std::any_of(written.begin(), written.end(), [&](const auto& span) {
+            return text_left < span.second + 2 * unit && span.first < text_right + 2 * unit;
+        });
+        if (overlaps) continue;
+        written.emplace_back(text_left, text_right);
+        canvas.text(text_left, text_top, label, unit, white);
+    }
+    write_rgb8(path, width, height, rgb);
 }
 
 }  // namespace csgrt

@@ -15,6 +15,7 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/csg/scene.h"
+#include "csgrt/render/materials.h"
 #include "csgrt/render/sampling.h"
 #include "csgrt/render/shadow_offset.h"
 
@@ -43,17 +44,35 @@ double scene_magnitude(const Scene& scene) {
     return magnitude;
 }
 
-Vector3 albedo_of(const Scene& scene, std::uint32_t object_id) {
-    if (object_id >= scene.objects().size()) return Material{}.albedo;
+/// What one worker counts for the statistics (RenderStats), summed when the render ends.
+struct RayTally {
+    std::uint64_t shadow_rays = 0;
+    std::uint64_t shadow_rays_blocked = 0;
+    std::uint64_t secondary_rays = 0;
+    std::uint64_t primary_hits = 0;
+    TraversalCounters centre_ray_work;
+    /// Sized to the scene's objects once per worker, so counting allocates nothing per ray.
+    std::vector<std::uint64_t> hits_per_object;
+
+    void count_hit(std::uint32_t object_id) {
+        ++primary_hits;
+        if (object_id < hits_per_object.size()) ++hits_per_object[object_id];
+    }
+};
+
+const Material& material_of(const Scene& scene, std::uint32_t object_id) {
+    static const Material kDefault;
+    if (object_id >= scene.objects().size()) return kDefault;
     const std::uint32_t material = scene.objects()[object_id].material;
-    if (material >= scene.materials().size()) return Material{}.albedo;
-    return scene.materials()[material].albedo;
+    if (material >= scene.materials().size()) return kDefault;
+    return scene.materials()[material];
 }
 
 /// Linear radiance leaving `hit` toward the camera along `ray` (unit direction).
 Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
-              std::uint64_t& shadow_rays) {
-    const Vector3 albedo = albedo_of(frame.scene, hit.object_id);
+              RayTally& tally) {
+    const Material& material = material_of(frame.scene, hit.object_id);
+    const Vector3& albedo = material.albedo;
     const Vector3 view = -ray.direction;
     // Both sides of every surface are shaded: turn the normals to the side the ray came from.
     Normal3 geometric = hit.geometric_normal;
@@ -63,11 +82,11 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
 
     if (frame.scene.lights().empty()) {
         // An eye light: without it a scene without lights would render black.
-        return albedo * std::abs(shading.dot(view));
+        return albedo * std::abs(shading.dot(view)) + albedo.cwiseProduct(frame.settings.ambient);
     }
 
     const Point3 origin = offset_ray_origin(hit.point, geometric, frame.scene_magnitude);
-    Vector3 radiance = Vector3::Zero();
+    Vector3 radiance = albedo.cwiseProduct(frame.settings.ambient);
     for (const Light& light : frame.scene.lights()) {
         Vector3 to_light;
         Vector3 irradiance;
@@ -78,7 +97,10 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
             const double distance_squared = offset.squaredNorm();
             if (!(distance_squared > 0.0)) continue;
             to_light = offset / std::sqrt(distance_squared);
-            irradiance = point->intensity / distance_squared;
+            irradiance =
+                point->falloff == 2.0
+                    ? Vector3(point->intensity / distance_squared)
+                    : Vector3(point->intensity / std::pow(distance_squared, 0.5 * point->falloff));
             // Up to the light, stopping short of it by the same relative margin the origin
             // keeps from the surface, so a light lying on a surface is not hidden by it.
             shadow.direction = point->position - origin;
@@ -93,15 +115,88 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
         const double cosine = shading.dot(to_light);
         // A light behind the surface (by either normal) sends nothing and needs no shadow ray.
         if (!(cosine > 0.0) || !(geometric.dot(to_light) > 0.0)) continue;
-        ++shadow_rays;
-        if (frame.scene.occluded(shadow, scratch)) continue;
+        ++tally.shadow_rays;
+        if (frame.scene.occluded(shadow, scratch)) {
+            ++tally.shadow_rays_blocked;
+            continue;
+        }
         radiance += albedo.cwiseProduct(irradiance) * (cosine / kPi);
+        if (material.specular.maxCoeff() > 0.0) {
+            const double lobe = phong_lobe(to_light, view, shading, material.shininess);
+            radiance += material.specular.cwiseProduct(irradiance) * (lobe * cosine);
+        }
+    }
+    return radiance;
+}
+
+Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
+                      RayTally& tally, int depth);
+
+/// Radiance arriving along a mirror or glass ray spawned at bounce `depth` (1 for the first).
+Vector3 trace(const Frame& frame, const Ray& ray, QueryScratch& scratch, RayTally& tally,
+              int depth) {
+    if (depth > frame.settings.max_depth) return Vector3::Zero();
+    ++tally.secondary_rays;
+    const std::optional<Hit> hit = frame.scene.intersect(ray, scratch);
+    if (!hit) return frame.settings.background;
+    return shade_surface(frame, ray, *hit, scratch, tally, depth);
+}
+
+/// A ray leaving hit.point along `direction`, on the side of `side` (the geometric normal
+/// turned to that side), from the offset origin shadow rays use.
+Ray spawned_ray(const Frame& frame, const Hit& hit, const Normal3& side, const Vector3& direction) {
+    Ray ray;
+    ray.origin = offset_ray_origin(hit.point, side, frame.scene_magnitude);
+    ray.direction = direction;
+    ray.t_max = kInfinity;
+    return ray;
+}
+
+/// The radiance leaving `hit` along -ray.direction: glass (render/materials.h) by Fresnel
+/// reflection and refraction; other materials by direct light (shade) plus mirror reflection.
+Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
+                      RayTally& tally, int depth) {
+    const Material& material = material_of(frame.scene, hit.object_id);
+    const Vector3& direction = ray.direction;
+    if (material.ior > 0.0) {
+        // The surface's own normal is outward (CSG results included), so its sign says whether
+        // the ray enters or leaves the solid.
+        const bool entering = direction.dot(hit.geometric_normal) < 0.0;
+        const Normal3 geometric = entering ? hit.geometric_normal : -hit.geometric_normal;
+        Normal3 normal = entering ? hit.shading_normal : -hit.shading_normal;
+        if (normal.dot(geometric) < 0.0) normal = geometric;
+        const double eta_incident = entering ? 1.0 : material.ior;
+        const double eta_transmitted = entering ? material.ior : 1.0;
+        const double reflectance =
+            fresnel_dielectric(-direction.dot(normal), eta_incident, eta_transmitted);
+        Vector3 radiance =
+            reflectance * trace(frame,
+                                spawned_ray(frame, hit, geometric, reflect(direction, normal)),
+                                scratch, tally, depth + 1);
+        if (reflectance < 1.0) {
+            if (const auto refracted = refract(direction, normal, eta_incident / eta_transmitted)) {
+                radiance += (1.0 - reflectance) *
+                            trace(frame, spawned_ray(frame, hit, -geometric, *refracted), scratch,
+                                  tally, depth + 1);
+            }
+        }
+        return radiance;
+    }
+    Vector3 radiance = shade(frame, ray, hit, scratch, tally);
+    if (material.mirror.maxCoeff() > 0.0 && depth < frame.settings.max_depth) {
+        const Normal3 geometric = direction.dot(hit.geometric_normal) < 0.0 ? hit.geometric_normal
+                                                                            : -hit.geometric_normal;
+        Normal3 normal = hit.shading_normal;
+        if (normal.dot(geometric) < 0.0) normal = -normal;
+        radiance += material.mirror.cwiseProduct(
+            trace(frame, spawned_ray(frame, hit, geometric, reflect(direction, normal)), scratch,
+                  tally, depth + 1));
     }
     return radiance;
 }
 
 void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& scratch,
-                  std::uint64_t& shadow_rays) {
+                  RayTally& tally) {
     const RenderSettings& settings = frame.settings;
     const double width = settings.width;
     const double height = settings.height;
@@ -111,7 +206,11 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
     TraversalCounters counters;
     const std::optional<Hit> centre_hit = frame.scene.intersect_counted(centre, scratch, counters);
     pixel.cost = static_cast<float>(counters.nodes_visited + counters.primitives_tested);
+    tally.centre_ray_work.nodes_visited += counters.nodes_visited;
+    tally.centre_ray_work.primitives_tested += counters.primitives_tested;
+    tally.centre_ray_work.boxes_tested += counters.boxes_tested;
     if (centre_hit) {
+        tally.count_hit(centre_hit->object_id);
         pixel.depth = static_cast<float>(centre_hit->t);
         pixel.normal_x = static_cast<float>(centre_hit->shading_normal.x());
         pixel.normal_y = static_cast<float>(centre_hit->shading_normal.y());
@@ -123,8 +222,10 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
     int covered = 0;
     if (settings.samples_per_pixel == 1) {
         if (centre_hit) {
-            colour = shade(frame, centre, *centre_hit, scratch, shadow_rays);
+            colour = shade_surface(frame, centre, *centre_hit, scratch, tally, 0);
             covered = 1;
+        } else {
+            colour = settings.background;
         }
     } else {
         SampleRandom random = pixel_random(settings.seed, x, y);
@@ -132,8 +233,12 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
             const Vector2 film = stratified_sample(frame.strata, sample, random);
             const Ray ray = frame.film.ray((x + film.x()) / width, (y + film.y()) / height);
             const std::optional<Hit> hit = frame.scene.intersect(ray, scratch);
-            if (!hit) continue;
-            colour += shade(frame, ray, *hit, scratch, shadow_rays);
+            if (!hit) {
+                colour += settings.background;
+                continue;
+            }
+            tally.count_hit(hit->object_id);
+            colour += shade_surface(frame, ray, *hit, scratch, tally, 0);
             ++covered;
         }
     }
@@ -157,6 +262,12 @@ void validate(const RenderSettings& settings) {
     require(settings.threads >= 0, "RenderSettings", "threads", ">= 0 (0: all cores)",
             settings.threads);
     require(settings.tile_size >= 1, "RenderSettings", "tile_size", ">= 1", settings.tile_size);
+    require(settings.max_depth >= 0 && settings.max_depth <= kMaxTraceDepth, "RenderSettings",
+            "max_depth", "in [0, " + std::to_string(kMaxTraceDepth) + "]", settings.max_depth);
+    require(settings.background.allFinite() && (settings.background.array() >= 0.0).all(),
+            "RenderSettings", "background", "finite and >= 0", settings.background);
+    require(settings.ambient.allFinite() && (settings.ambient.array() >= 0.0).all(),
+            "RenderSettings", "ambient", "finite and >= 0", settings.ambient);
 }
 
 RenderResult render(const Scene& scene, const RenderSettings& settings) {
@@ -173,25 +284,28 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
     const int tiles_x = (settings.width + settings.tile_size - 1) / settings.tile_size;
     const int tiles_y = (settings.height + settings.tile_size - 1) / settings.tile_size;
     const int tile_count = tiles_x * tiles_y;
-    // One scratch per worker thread, reused across its tiles.
+    // One scratch and one tally per worker thread, reused across its tiles.
     tbb::enumerable_thread_specific<QueryScratch> scratches;
-    std::atomic<std::uint64_t> shadow_rays{0};
+    tbb::enumerable_thread_specific<RayTally> tallies([&scene] {
+        RayTally tally;
+        tally.hits_per_object.assign(scene.objects().size(), 0);
+        return tally;
+    });
     std::atomic<int> tiles_done{0};
 
     auto render_tiles = [&](const tbb::blocked_range<int>& range) {
         QueryScratch& scratch = scratches.local();
+        RayTally& tally = tallies.local();
         for (int tile = range.begin(); tile != range.end(); ++tile) {
             const int x0 = (tile % tiles_x) * settings.tile_size;
             const int y0 = (tile / tiles_x) * settings.tile_size;
             const int x1 = std::min(x0 + settings.tile_size, settings.width);
             const int y1 = std::min(y0 + settings.tile_size, settings.height);
-            std::uint64_t tile_shadow_rays = 0;
             for (int y = y0; y < y1; ++y) {
                 for (int x = x0; x < x1; ++x) {
-                    render_pixel(frame, x, y, result.image.at(x, y), scratch, tile_shadow_rays);
+                    render_pixel(frame, x, y, result.image.at(x, y), scratch, tally);
                 }
             }
-            shadow_rays += tile_shadow_rays;
             const int done = ++tiles_done;
             if (settings.progress) settings.progress(double(done) / tile_count);
         }
@@ -209,7 +323,20 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
     const auto pixels = static_cast<std::uint64_t>(result.image.pixel_count());
     const auto samples = static_cast<std::uint64_t>(settings.samples_per_pixel);
     result.stats.primary_rays = pixels * samples + (samples > 1 ? pixels : 0);
-    result.stats.shadow_rays = shadow_rays.load();
+    // Integer sums: the same whichever thread counted what.
+    result.stats.hits_per_object.assign(scene.objects().size(), 0);
+    for (const RayTally& tally : tallies) {
+        result.stats.shadow_rays += tally.shadow_rays;
+        result.stats.shadow_rays_blocked += tally.shadow_rays_blocked;
+        result.stats.secondary_rays += tally.secondary_rays;
+        result.stats.primary_hits += tally.primary_hits;
+        result.stats.centre_ray_work.nodes_visited += tally.centre_ray_work.nodes_visited;
+        result.stats.centre_ray_work.primitives_tested += tally.centre_ray_work.primitives_tested;
+        result.stats.centre_ray_work.boxes_tested += tally.centre_ray_work.boxes_tested;
+        for (std::size_t i = 0; i < tally.hits_per_object.size(); ++i) {
+            result.stats.hits_per_object[i] += tally.hits_per_object[i];
+        }
+    }
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

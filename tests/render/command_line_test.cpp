@@ -168,6 +168,8 @@ TEST_F(CommandLine, BadArgumentsGiveOneLineAndNoFiles) {
         {{"render", scene_, "-o", output_, "--threads", "-1"}, "--threads"},
         {{"render", scene_, "-o", output_, "--accel", "octree"}, "unknown structure"},
         {{"render", scene_, "-o", output_, "--bogus"}, "--bogus"},
+        {{"render", scene_, "-o", output_, "--tonemap", "aces"}, "--tonemap aces: unknown curve"},
+        {{"render", scene_, "-o", output_, "--exposure", "100"}, "--exposure must be in"},
         {{"render", (directory_ / "missing.json").string(), "-o", output_}, "missing.json"},
         {{"render", directory_.string(), "-o", output_}, "is a directory"},
         {{"render", scene_, "-o", (directory_ / "no" / "out.exr").string()}, "does not exist"},
@@ -180,6 +182,28 @@ TEST_F(CommandLine, BadArgumentsGiveOneLineAndNoFiles) {
         expect_one_line_error(run(arguments), fragment);
     }
     expect_no_output();
+}
+
+TEST_F(CommandLine, StatsPrintsATableOfRaysHitsWorkAndTimes) {
+    const ProgramRun result = run({"render", scene_, "-o", output_, "--width", "20", "--height",
+                                   "10", "--accel", "brute", "--stats", "--tonemap", "reinhard"});
+    ASSERT_EQ(result.status, 0) << result.err;
+    for (const char* fragment :
+         {"Rays", "camera", "shadow", "% blocked", "Camera-ray hits", "Top-level structure (brute)",
+          "primitives tested", "Time", "load scene", "commit", "render", "write files"}) {
+        EXPECT_NE(result.out.find(fragment), std::string::npos) << fragment << ": " << result.out;
+    }
+    // 200 camera rays at 1 spp, their count printed in the table as in the summary line.
+    EXPECT_NE(result.out.find("camera                                  200"), std::string::npos)
+        << result.out;
+    // Without --timing-in-header the EXR holds no timing; with it, it does.
+    EXPECT_FALSE(read_exr(output_).metadata.include_timing);
+    ASSERT_EQ(run({"render", scene_, "-o", output_, "--width", "8", "--height", "8",
+                   "--timing-in-header"})
+                  .status,
+              0);
+    EXPECT_TRUE(read_exr(output_).metadata.include_timing);
+    EXPECT_EQ(read_exr(output_).metadata.objects.size(), 3u);
 }
 
 TEST_F(CommandLine, EveryDocumentedStructureRendersTheSameImage) {

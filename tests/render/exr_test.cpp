@@ -4,8 +4,11 @@
 #include <OpenEXR/ImfDoubleAttribute.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfIDManifest.h>
 #include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfInputPart.h>
 #include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
@@ -17,6 +20,8 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -73,9 +78,12 @@ ExrMetadata sample_metadata() {
     metadata.camera.up = Vector3(0, 1, 0);
     metadata.camera.vertical_fov_degrees = 35.0;
     metadata.accelerator = "brute";
+    metadata.include_timing = true;
     metadata.accelerator_build_milliseconds = 1.25;
+    metadata.render_seconds = 0.5;
     metadata.samples_per_pixel = 16;
     metadata.scene = "sample.json";
+    metadata.objects = {{"ground", "plane", "floor"}, {"ball", "sphere", "red"}};
     return metadata;
 }
 
@@ -86,14 +94,15 @@ TEST(WriteExr, WritesTheDocumentedChannelsAndAttributes) {
     // Nothing but the file itself is left behind.
     EXPECT_EQ(names_in(directory), std::vector<std::string>{"out.exr"});
 
-    // Read with OpenEXR directly, independently of read_exr.
+    // Read with OpenEXR directly, independently of read_exr. A one-part reader sees the
+    // first part, "rgba"; the id is in the second.
     Imf::InputFile file((directory / "out.exr").c_str());
     const Imf::Header& header = file.header();
     const Imf::ChannelList& channels = header.channels();
     const std::vector<std::pair<std::string, Imf::PixelType>> expected = {
-        {"A", Imf::HALF},     {"B", Imf::HALF},    {"G", Imf::HALF}, {"N.X", Imf::FLOAT},
-        {"N.Y", Imf::FLOAT},  {"N.Z", Imf::FLOAT}, {"R", Imf::HALF}, {"Z", Imf::FLOAT},
-        {"cost", Imf::FLOAT}, {"id", Imf::UINT}};
+        {"A", Imf::HALF},    {"B", Imf::HALF},    {"G", Imf::HALF},
+        {"N.X", Imf::FLOAT}, {"N.Y", Imf::FLOAT}, {"N.Z", Imf::FLOAT},
+        {"R", Imf::HALF},    {"Z", Imf::FLOAT},   {"cost", Imf::FLOAT}};
     std::vector<std::pair<std::string, Imf::PixelType>> found;
     for (auto it = channels.begin(); it != channels.end(); ++it) {
         found.emplace_back(it.name(), it.channel().type);
@@ -133,10 +142,24 @@ TEST(WriteExr, WritesTheDocumentedChannelsAndAttributes) {
                                         sizeof(float), 5 * sizeof(float)));
     frame_buffer.insert("cost", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(cost.data()),
                                            sizeof(float), 5 * sizeof(float)));
-    frame_buffer.insert("id", Imf::Slice(Imf::UINT, reinterpret_cast<char*>(id.data()),
-                                         sizeof(std::uint32_t), 5 * sizeof(std::uint32_t)));
     file.setFrameBuffer(frame_buffer);
     file.readPixels(0, 2);
+    Imf::MultiPartInputFile parts((directory / "out.exr").c_str());
+    ASSERT_EQ(parts.parts(), 2);
+    EXPECT_EQ(parts.header(0).name(), "rgba");
+    EXPECT_EQ(parts.header(1).name(), "id");
+    const Imf::ChannelList& id_channels = parts.header(1).channels();
+    ASSERT_NE(id_channels.findChannel("id"), nullptr);
+    EXPECT_EQ(id_channels.findChannel("id")->type, Imf::UINT);
+    int id_channel_count = 0;
+    for (auto it = id_channels.begin(); it != id_channels.end(); ++it) ++id_channel_count;
+    EXPECT_EQ(id_channel_count, 1);
+    Imf::FrameBuffer id_buffer;
+    id_buffer.insert("id", Imf::Slice(Imf::UINT, reinterpret_cast<char*>(id.data()),
+                                      sizeof(std::uint32_t), 5 * sizeof(std::uint32_t)));
+    Imf::InputPart id_part(parts, 1);
+    id_part.setFrameBuffer(id_buffer);
+    id_part.readPixels(0, 2);
     for (int y = 0; y < 3; ++y) {
         for (int x = 0; x < 5; ++x) {
             const Pixel& pixel = image.at(x, y);
@@ -180,6 +203,62 @@ TEST(ReadExr, RoundTripsPixelsAndMetadata) {
     EXPECT_EQ(file.metadata.camera.look_at, Point3(1, 2, 0));
     EXPECT_EQ(file.metadata.accelerator, "brute");
     EXPECT_EQ(file.metadata.samples_per_pixel, 16);
+}
+
+TEST(WriteExr, TheIdManifestNamesEveryObject) {
+    const auto directory = fresh_directory("exr_manifest");
+    write_exr(directory / "out.exr", sample_image(), sample_metadata());
+    // Read with OpenEXR's own manifest class, independently of read_exr.
+    Imf::MultiPartInputFile parts((directory / "out.exr").c_str());
+    ASSERT_TRUE(Imf::hasIDManifest(parts.header(1)));
+    EXPECT_FALSE(Imf::hasIDManifest(parts.header(0)));
+    const Imf::IDManifest manifest(Imf::idManifest(parts.header(1)));
+    ASSERT_EQ(manifest.size(), 1u);
+    const auto& group = manifest[0];
+    EXPECT_EQ(group.getChannels(), std::set<std::string>{"id"});
+    EXPECT_EQ(group.getComponents(), (std::vector<std::string>{"name", "shape", "material"}));
+    EXPECT_EQ(group.getEncodingScheme(), Imf::IDManifest::ID_SCHEME);
+    EXPECT_EQ(group.getHashScheme(), Imf::IDManifest::NOTHASHED);
+    ASSERT_EQ(group.size(), 2u);
+    EXPECT_EQ(group.find(0).text(), (std::vector<std::string>{"ground", "plane", "floor"}));
+    EXPECT_EQ(group.find(1).text(), (std::vector<std::string>{"ball", "sphere", "red"}));
+
+    const ExrFile file = read_exr(directory / "out.exr");
+    ASSERT_EQ(file.metadata.objects.size(), 2u);
+    EXPECT_EQ(file.metadata.objects[1].name, "ball");
+    EXPECT_EQ(file.metadata.objects[1].shape, "sphere");
+    EXPECT_EQ(file.metadata.objects[1].material, "red");
+}
+
+TEST(WriteExr, IdenticalImagesGiveByteIdenticalFilesWithoutTimings) {
+    const auto directory = fresh_directory("exr_identical");
+    auto bytes = [](const std::filesystem::path& path) {
+        std::ifstream in(path, std::ios::binary);
+        std::ostringstream text;
+        text << in.rdbuf();
+        return text.str();
+    };
+    ExrMetadata metadata = sample_metadata();
+    metadata.include_timing = false;
+    metadata.accelerator_build_milliseconds = 1.0;
+    write_exr(directory / "a.exr", sample_image(), metadata);
+    metadata.accelerator_build_milliseconds = 2.0;  // a different timing: not in the file
+    metadata.render_seconds = 7.0;
+    write_exr(directory / "b.exr", sample_image(), metadata);
+    const std::string a = bytes(directory / "a.exr");
+    EXPECT_GT(a.size(), 100u);
+    EXPECT_EQ(a, bytes(directory / "b.exr"));
+    Imf::InputFile file((directory / "a.exr").c_str());
+    EXPECT_TRUE(file.header().find("acceleratorBuildMs") == file.header().end());
+    EXPECT_TRUE(file.header().find("renderSeconds") == file.header().end());
+    EXPECT_FALSE(read_exr(directory / "a.exr").metadata.include_timing);
+
+    metadata.include_timing = true;  // asked for: recorded, and read back
+    write_exr(directory / "c.exr", sample_image(), metadata);
+    const ExrFile timed = read_exr(directory / "c.exr");
+    EXPECT_TRUE(timed.metadata.include_timing);
+    EXPECT_EQ(timed.metadata.accelerator_build_milliseconds, 2.0);
+    EXPECT_EQ(timed.metadata.render_seconds, 7.0);
 }
 
 TEST(WriteExr, LeavesNothingWhenTheDirectoryIsMissing) {

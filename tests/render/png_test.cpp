@@ -140,6 +140,54 @@ TEST(WriteCostPng, NormalisesByTheLargestCost) {
     EXPECT_EQ(read_png(directory / "flat.png").at(1, 1), code(0.0));
 }
 
+TEST(WriteColourPng, AppliesTheToneMapping) {
+    const auto directory = fresh_directory("png_tone_mapped");
+    Image image(2, 1);
+    image.at(0, 0) = Pixel{.red = 1.0f, .green = 3.0f, .blue = 0.0f, .alpha = 1.0f};
+    image.at(1, 0) = Pixel{.red = 1000.0f, .green = 0.25f, .blue = 0.5f, .alpha = 1.0f};
+    write_colour_png(directory / "r.png", image, ToneMapping{ToneCurve::Reinhard, 0.0});
+    const Rgb8 png = read_png(directory / "r.png");
+    // Reinhard: 1 -> 0.5, 3 -> 0.75, 0.25 -> 0.2, each sRGB encoded; 1000 stays below 255.
+    EXPECT_EQ(png.at(0, 0), (std::array<int, 3>{encode_srgb8(0.5), encode_srgb8(0.75), 0}));
+    EXPECT_EQ(png.at(1, 0)[1], encode_srgb8(0.2));
+    EXPECT_EQ(png.at(1, 0)[0], encode_srgb8(1000.0 / 1001.0));
+    EXPECT_EQ(png.at(1, 0)[2], encode_srgb8(0.5 / 1.5));
+}
+
+TEST(WriteCostPng, DrawsALabelledScaleBelowTheImage) {
+    const auto directory = fresh_directory("png_cost_scale");
+    Image image(200, 10);
+    for (int y = 0; y < 10; ++y) {
+        for (int x = 0; x < 200; ++x) image.at(x, y).cost = float(2 * x);  // 0 .. 398
+    }
+    write_cost_png(directory / "cost.png", image);
+    const Rgb8 png = read_png(directory / "cost.png");
+    ASSERT_EQ(png.width, 200);
+    ASSERT_EQ(png.height, 10 + cost_scale_height(200));
+    auto code = [](double t) {
+        const Vector3 c = viridis(t);
+        return std::array<int, 3>{int(std::lround(c.x() * 255)), int(std::lround(c.y() * 255)),
+                                  int(std::lround(c.z() * 255))};
+    };
+    // The bar runs from viridis(0) at its left end to viridis(1) at its right end, three pixels
+    // in from each side (the margin at this width), three rows below the image.
+    const int bar_row = 10 + 3 + 5;
+    EXPECT_EQ(png.at(3, bar_row), code(0.0));
+    EXPECT_EQ(png.at(196, bar_row), code(1.0));
+    EXPECT_EQ(png.at(2, bar_row), (std::array<int, 3>{24, 24, 24}));  // the strip's background
+    // The numbers are drawn in the light colour in the text rows; count their pixels.
+    int lit = 0;
+    for (int y = 10 + 3 + 10 + 4; y < png.height; ++y) {
+        for (int x = 0; x < 200; ++x) lit += png.at(x, y) == std::array<int, 3>{235, 235, 235};
+    }
+    EXPECT_GT(lit, 50);
+    EXPECT_EQ(cost_label(0.0), "0");
+    EXPECT_EQ(cost_label(398.0), "398");
+    EXPECT_EQ(cost_label(99.5), "99.5");
+    EXPECT_EQ(cost_label(12345.0), "12.3k");
+    EXPECT_EQ(cost_label(2.5e6), "2.5M");
+}
+
 TEST(WriteColourPng, ReportsAnUnwritablePath) {
     const auto directory = fresh_directory("png_bad");
     EXPECT_THROW(write_colour_png(directory / "missing" / "c.png", Image(1, 1)),

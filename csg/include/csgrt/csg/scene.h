@@ -18,6 +18,15 @@ namespace csgrt {
 struct Material {
     std::string name;
     Vector3 albedo{0.8, 0.8, 0.8};
+    /// Normalised Phong specular colour added to the Lambert term (render/materials.h; 0: none;
+    /// albedo + specular <= 1 per channel conserves energy), and its exponent.
+    Vector3 specular{0.0, 0.0, 0.0};
+    double shininess = 32.0;
+    /// Perfect-mirror reflectance per channel (0: none), traced to RenderSettings::max_depth.
+    Vector3 mirror{0.0, 0.0, 0.0};
+    /// Index of refraction of a dielectric (glass 1.5): reflects and refracts by Fresnel's
+    /// equations, total internal reflection included, instead of the terms above. 0: opaque.
+    double ior = 0.0;
 };
 
 /// Light from a point, falling off with the squared distance.
@@ -25,6 +34,9 @@ struct PointLight {
     Point3 position{0.0, 10.0, 0.0};
     /// Linear RGB intensity (radiance times squared distance).
     Vector3 intensity{100.0, 100.0, 100.0};
+    /// The exponent k of the falloff, irradiance = intensity / distance^k: 2 is physical;
+    /// 1 and 0 match renderers whose lights fade linearly or not at all.
+    double falloff = 2.0;
 };
 
 /// Light from infinitely far away, arriving along `direction` (the way the light travels).

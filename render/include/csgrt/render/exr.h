@@ -2,27 +2,51 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "csgrt/csg/camera.h"
 #include "csgrt/render/image.h"
+#include "csgrt/render/tonemap.h"
 
 namespace csgrt {
 
+class Scene;
+
+/// A scene object as the EXR's idManifest names it: the id channel's value v means
+/// objects[v]. `name` is the object's name, or "object N" (N its index) when it has none.
+struct ExrObject {
+    std::string name;
+    /// Shape::kind() of the object's top shape ("sphere", "difference", "mesh", ...).
+    std::string shape;
+    std::string material;
+};
+
 /// What an EXR written by csgrt records about the render besides its pixels, as header
-/// attributes: the camera (cameraProjection, cameraPosition, cameraLookAt, cameraUp,
-/// cameraVerticalFov or cameraOrthographicHeight, and the standard worldToCamera matrix),
-/// the resolution (resolution, besides the data window), the structure over the scene's
-/// objects (accelerator, acceleratorBuildMs), samplesPerPixel and the scene's name (scene).
+/// attributes of its first part: the camera (cameraProjection, cameraPosition, cameraLookAt,
+/// cameraUp, cameraVerticalFov or cameraOrthographicHeight, and the standard worldToCamera
+/// matrix), the resolution (resolution, besides the data window), the structure over the
+/// scene's objects (accelerator), samplesPerPixel and the scene's name (scene); and in the id
+/// part the standard idManifest naming every object. Timings (acceleratorBuildMs,
+/// renderSeconds) are written only when `include_timing` is set, so that identical renders
+/// give byte-identical files.
 struct ExrMetadata {
     Camera camera;
     std::string accelerator;
+    bool include_timing = false;
     double accelerator_build_milliseconds = 0.0;
+    double render_seconds = 0.0;
     int samples_per_pixel = 1;
     std::string scene;
+    std::vector<ExrObject> objects;
 };
 
-/// The channels of a csgrt EXR: R, G, B, A as half (linear, premultiplied); Z, N.X, N.Y, N.Z
-/// and cost as float; id as uint (kNoIndex = 4294967295 for background). ZIP compressed.
+/// The idManifest's entries for a committed or uncommitted scene: one per object, in order.
+std::vector<ExrObject> exr_objects(const Scene& scene);
+
+/// A csgrt EXR has two parts (OpenEXR 2 multi-part; docs/rendering.md):
+/// - "rgba": R, G, B, A as half (linear, premultiplied); Z, N.X, N.Y, N.Z and cost as float;
+/// - "id": id as uint (kNoIndex = 4294967295 for background), with the idManifest.
+/// ZIP compressed, no timestamps. Readers that know one part only (Imf::InputFile) see "rgba".
 /// Written to a temporary file in the same directory and renamed over `path`, so `path` is
 /// either the old file or the complete new one. Throws std::runtime_error naming the path when
 /// it cannot be written.
@@ -34,16 +58,18 @@ struct ExrFile {
     ExrMetadata metadata;
 };
 
-/// Reads an EXR written by `write_exr`; channels it lacks keep Pixel's defaults. Throws
+/// Reads an EXR written by `write_exr` (or by earlier csgrt versions, all channels in one
+/// part); channels it lacks keep Pixel's defaults. Throws
 /// std::runtime_error naming the path when it cannot be read.
 ExrFile read_exr(const std::filesystem::path& path);
 
 /// Writes the EXR at `exr_path` and its two previews beside it: the colour as `stem.png`
-/// (png.h) and the cost channel as `stem.cost.png`. All three are written to temporary files
-/// first and renamed only when all three are complete; on an error none of them is left
-/// half-written and the temporaries are removed.
+/// (write_colour_png with `tone_mapping`) and the cost channel as `stem.cost.png`
+/// (write_cost_png, with its scale). All three are written to temporary files first and
+/// renamed only when all three are complete; on an error none of them is left half-written and
+/// the temporaries are removed.
 void write_render_files(const std::filesystem::path& exr_path, const Image& image,
-                        const ExrMetadata& metadata);
+                        const ExrMetadata& metadata, const ToneMapping& tone_mapping = {});
 
 /// The preview paths `write_render_files` uses for `exr_path` (out.exr -> out.png,
 /// out.cost.png).

@@ -2,6 +2,9 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
+
+#include "csgrt/accel/accelerator.h"
 
 #include "csgrt/render/image.h"
 
@@ -23,14 +26,24 @@ struct RenderSettings {
     int tile_size = 16;
     /// Seeds the per-pixel sample streams.
     std::uint64_t seed = 0;
+    /// Most bounces of mirror and glass rays (0: camera and shadow rays only); a ray that
+    /// would go deeper brings back black.
+    int max_depth = 5;
+    /// Linear radiance of rays that hit nothing. Camera samples that miss still count as
+    /// uncovered (alpha 0), so a non-black background is added to colour as emission.
+    Vector3 background{0.0, 0.0, 0.0};
+    /// Radiance arriving at every surface from every direction, unshadowed: adds
+    /// albedo * ambient to each opaque surface (the ambient term of classic renderers).
+    Vector3 ambient{0.0, 0.0, 0.0};
     /// Called from worker threads after each finished tile with the fraction done; must be
     /// thread-safe and cheap. May be empty.
     std::function<void(double fraction_done)> progress;
 };
 
-/// Largest width or height `render` accepts, and the most samples per pixel.
+/// Largest width or height `render` accepts, the most samples per pixel and bounces.
 inline constexpr int kMaxImageSize = 16384;
 inline constexpr int kMaxSamplesPerPixel = 4096;
+inline constexpr int kMaxTraceDepth = 64;
 
 /// What a render did.
 struct RenderStats {
@@ -38,11 +51,24 @@ struct RenderStats {
     /// feeds the AOVs.
     std::uint64_t primary_rays = 0;
     std::uint64_t shadow_rays = 0;
+    /// Mirror reflection and glass reflection and refraction rays.
+    std::uint64_t secondary_rays = 0;
+    /// Shadow rays that found something between the surface and the light.
+    std::uint64_t shadow_rays_blocked = 0;
+    /// Camera rays that hit an object (colour samples and the separate centre rays).
+    std::uint64_t primary_hits = 0;
+    /// Camera-ray hits per top-level object, indexed by object id.
+    std::vector<std::uint64_t> hits_per_object;
+    /// The top-level structure's work for the centre rays, summed over the image (the cost
+    /// channel's total): nodes or cells visited, primitives tested, boxes tested.
+    TraversalCounters centre_ray_work;
     double seconds = 0.0;
 
     double million_rays_per_second() const {
-        return seconds > 0.0 ? 1e-6 * static_cast<double>(primary_rays + shadow_rays) / seconds
-                             : 0.0;
+        return seconds > 0.0
+                   ? 1e-6 * static_cast<double>(primary_rays + shadow_rays + secondary_rays) /
+                         seconds
+                   : 0.0;
     }
 };
 

@@ -1,0 +1,48 @@
+#include "csgrt/render/tonemap.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "csgrt/core/error.h"
+
+namespace csgrt {
+
+ToneCurve parse_tone_curve(std::string_view name) {
+    if (name == "clamp") return ToneCurve::Clamp;
+    if (name == "reinhard") return ToneCurve::Reinhard;
+    if (name == "filmic") return ToneCurve::Filmic;
+    require(false, "ToneMapping", "curve", "one of clamp, reinhard, filmic", std::string(name));
+    return ToneCurve::Filmic;
+}
+
+std::string_view tone_curve_name(ToneCurve curve) {
+    switch (curve) {
+        case ToneCurve::Clamp:
+            return "clamp";
+        case ToneCurve::Reinhard:
+            return "reinhard";
+        case ToneCurve::Filmic:
+            return "filmic";
+    }
+    return "filmic";
+}
+
+double tone_map(double linear, const ToneMapping& mapping) {
+    // NaN-safe: a NaN or a negative value becomes 0 before the curve.
+    const double x = linear > 0.0 ? linear * std::exp2(mapping.exposure_stops) : 0.0;
+    switch (mapping.curve) {
+        case ToneCurve::Clamp:
+            return std::min(x, 1.0);
+        case ToneCurve::Reinhard:
+            return std::isinf(x) ? 1.0 : x / (1.0 + x);
+        case ToneCurve::Filmic: {
+            if (std::isinf(x)) return 1.0;
+            const double s = 0.6 * x;  // Narkowicz's scale from ACES's input to the fit's
+            const double mapped = (s * (2.51 * s + 0.03)) / (s * (2.43 * s + 0.59) + 0.14);
+            return std::clamp(mapped, 0.0, 1.0);
+        }
+    }
+    return 0.0;
+}
+
+}  // namespace csgrt
