@@ -176,6 +176,7 @@ void check_crossing_outputs(const CrossingOutputs<Real>& outputs, std::size_t n)
     check_optional(outputs.t.size(), total, "t");
     check_optional(outputs.object_id.size(), total, "object_id");
     check_optional(outputs.primitive_id.size(), total, "primitive_id");
+    check_optional(outputs.uv.size(), 2 * total, "uv");
     check_optional(outputs.entering.size(), total, "entering");
 }
 
@@ -270,8 +271,8 @@ void intersect(const Scene& scene, const RayArrays<Real>& rays,
     });
 }
 
-template <class Real>
-void intersect(const TriangleStructure<Real>& mesh, const RayArrays<Real>& rays,
+template <class Real, class SetReal>
+void intersect(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
                const NearestHitOutputs<Real>& outputs, const BatchConfig& config) {
     check_structure(mesh);
     check_rays(rays);
@@ -314,8 +315,8 @@ void occluded(const Scene& scene, const RayArrays<Real>& rays, std::span<std::ui
     });
 }
 
-template <class Real>
-void occluded(const TriangleStructure<Real>& mesh, const RayArrays<Real>& rays,
+template <class Real, class SetReal>
+void occluded(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
               std::span<std::uint8_t> occluded, const BatchConfig& config) {
     check_structure(mesh);
     check_rays(rays);
@@ -340,8 +341,8 @@ void count_crossings(const Scene& scene, const RayArrays<Real>& rays,
     });
 }
 
-template <class Real>
-void count_crossings(const TriangleStructure<Real>& mesh, const RayArrays<Real>& rays,
+template <class Real, class SetReal>
+void count_crossings(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
                      std::span<std::uint32_t> counts, const BatchConfig& config) {
     check_structure(mesh);
     check_rays(rays);
@@ -382,6 +383,7 @@ void list_crossings(const Scene& scene, const RayArrays<Real>& rays,
                     write1(outputs.t, at, static_cast<Real>(hit.t));
                     write1(outputs.object_id, at, hit.object_id);
                     write1(outputs.primitive_id, at, hit.primitive_id);
+                    write2(outputs.uv, at, hit.uv.x(), hit.uv.y());
                     write1(outputs.entering, at, std::uint8_t(hit.front_face ? 1 : 0));
                 }
                 ++k;
@@ -391,8 +393,8 @@ void list_crossings(const Scene& scene, const RayArrays<Real>& rays,
     });
 }
 
-template <class Real>
-void list_crossings(const TriangleStructure<Real>& mesh, const RayArrays<Real>& rays,
+template <class Real, class SetReal>
+void list_crossings(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
                     const CrossingOutputs<Real>& outputs, const BatchConfig& config) {
     check_structure(mesh);
     check_rays(rays);
@@ -412,6 +414,7 @@ void list_crossings(const TriangleStructure<Real>& mesh, const RayArrays<Real>& 
                 write1(outputs.t, at, static_cast<Real>(hits[k].t));
                 write1(outputs.object_id, at, object);
                 write1(outputs.primitive_id, at, primitive);
+                write2(outputs.uv, at, double(hits[k].u), double(hits[k].v));
                 if (!outputs.entering.empty()) {
                     const Normal3 n = triangle_normal(*mesh.triangles, hits[k].primitive);
                     outputs.entering[at] = n.dot(ray.direction) < 0.0 ? 1 : 0;
@@ -445,8 +448,8 @@ void contains(const Scene& scene, const VectorArray<Real>& points, std::span<std
     });
 }
 
-template <class Real>
-void contains(const TriangleStructure<Real>& mesh, const VectorArray<Real>& points,
+template <class Real, class SetReal>
+void contains(const TriangleStructure<SetReal>& mesh, const VectorArray<Real>& points,
               std::span<std::uint8_t> inside, const BatchConfig& config) {
     check_structure(mesh);
     check_size(inside.size(), points.count, "inside");
@@ -458,8 +461,8 @@ void contains(const TriangleStructure<Real>& mesh, const VectorArray<Real>& poin
     });
 }
 
-template <class Real>
-void closest_points(const TriangleStructure<Real>& mesh, const VectorArray<Real>& points,
+template <class Real, class SetReal>
+void closest_points(const TriangleStructure<SetReal>& mesh, const VectorArray<Real>& points,
                     const ClosestPointOutputs<Real>& outputs, const BatchConfig& config) {
     check_structure(mesh);
     if (mesh.closest_points == nullptr) {
@@ -503,7 +506,9 @@ void closest_points(const TriangleStructure<Real>& mesh, const VectorArray<Real>
     });
 }
 
-#define CSGRT_BATCH_INSTANTIATE(Real)                                                             \
+// Every query for float and double inputs, and the triangle queries for either precision of
+// rays over either precision of triangles.
+#define CSGRT_BATCH_SCENE(Real)                                                                  \
     template VectorArray<Real> interleaved_vectors(std::span<const Real>, std::string_view);    \
     template VectorArray<Real> strided_vectors(const Real*, std::size_t, std::ptrdiff_t);      \
     template VectorArray<Real> separate_vectors(std::span<const Real>, std::span<const Real>,  \
@@ -511,29 +516,35 @@ void closest_points(const TriangleStructure<Real>& mesh, const VectorArray<Real>
     template Normal3 triangle_normal(const TriangleSet<Real>&, std::size_t);                  \
     template void intersect(const Scene&, const RayArrays<Real>&,                             \
                             const NearestHitOutputs<Real>&, const BatchConfig&);              \
-    template void intersect(const TriangleStructure<Real>&, const RayArrays<Real>&,           \
-                            const NearestHitOutputs<Real>&, const BatchConfig&);              \
     template void occluded(const Scene&, const RayArrays<Real>&, std::span<std::uint8_t>,     \
                            const BatchConfig&);                                               \
-    template void occluded(const TriangleStructure<Real>&, const RayArrays<Real>&,            \
-                           std::span<std::uint8_t>, const BatchConfig&);                      \
     template void count_crossings(const Scene&, const RayArrays<Real>&,                       \
-                                  std::span<std::uint32_t>, const BatchConfig&);              \
-    template void count_crossings(const TriangleStructure<Real>&, const RayArrays<Real>&,     \
                                   std::span<std::uint32_t>, const BatchConfig&);              \
     template void list_crossings(const Scene&, const RayArrays<Real>&,                        \
                                  const CrossingOutputs<Real>&, const BatchConfig&);           \
-    template void list_crossings(const TriangleStructure<Real>&, const RayArrays<Real>&,      \
-                                 const CrossingOutputs<Real>&, const BatchConfig&);           \
     template void contains(const Scene&, const VectorArray<Real>&, std::span<std::uint8_t>,   \
-                           const BatchConfig&);                                               \
-    template void contains(const TriangleStructure<Real>&, const VectorArray<Real>&,          \
+                           const BatchConfig&);
+#define CSGRT_BATCH_TRIANGLES(Real, SetReal)                                                     \
+    template void intersect(const TriangleStructure<SetReal>&, const RayArrays<Real>&,        \
+                            const NearestHitOutputs<Real>&, const BatchConfig&);              \
+    template void occluded(const TriangleStructure<SetReal>&, const RayArrays<Real>&,         \
                            std::span<std::uint8_t>, const BatchConfig&);                      \
-    template void closest_points(const TriangleStructure<Real>&, const VectorArray<Real>&,    \
+    template void count_crossings(const TriangleStructure<SetReal>&, const RayArrays<Real>&,  \
+                                  std::span<std::uint32_t>, const BatchConfig&);              \
+    template void list_crossings(const TriangleStructure<SetReal>&, const RayArrays<Real>&,   \
+                                 const CrossingOutputs<Real>&, const BatchConfig&);           \
+    template void contains(const TriangleStructure<SetReal>&, const VectorArray<Real>&,       \
+                           std::span<std::uint8_t>, const BatchConfig&);                      \
+    template void closest_points(const TriangleStructure<SetReal>&, const VectorArray<Real>&, \
                                  const ClosestPointOutputs<Real>&, const BatchConfig&);
 
-CSGRT_BATCH_INSTANTIATE(float)
-CSGRT_BATCH_INSTANTIATE(double)
-#undef CSGRT_BATCH_INSTANTIATE
+CSGRT_BATCH_SCENE(float)
+CSGRT_BATCH_SCENE(double)
+CSGRT_BATCH_TRIANGLES(float, float)
+CSGRT_BATCH_TRIANGLES(float, double)
+CSGRT_BATCH_TRIANGLES(double, float)
+CSGRT_BATCH_TRIANGLES(double, double)
+#undef CSGRT_BATCH_SCENE
+#undef CSGRT_BATCH_TRIANGLES
 
 }  // namespace csgrt

@@ -169,14 +169,14 @@ TYPED_TEST(BatchTest, SceneOcclusionCrossingsAndMembership) {
     std::vector<std::uint32_t> object(offsets[2]), primitive(offsets[2]);
     std::vector<std::uint8_t> entering(offsets[2]);
     list_crossings(scene, through.arrays(),
-                   CrossingOutputs<Real>{offsets, t, object, primitive, entering});
+                   CrossingOutputs<Real>{offsets, t, object, primitive, {}, entering});
     EXPECT_EQ(t, (std::vector<Real>{4, 6, 4}));
     EXPECT_EQ(object, (std::vector<std::uint32_t>{0, 0, 0}));
     EXPECT_EQ(entering, (std::vector<std::uint8_t>{1, 0, 1}));
     // Offsets that do not come from the same rays are refused, not overrun.
     std::vector<std::uint64_t> wrong{0, 1, 3};
     EXPECT_THROW(list_crossings(scene, through.arrays(),
-                                CrossingOutputs<Real>{wrong, t, object, primitive, entering}),
+                                CrossingOutputs<Real>{wrong, t, object, primitive, {}, entering}),
                  InvalidParameter);
 
     // Membership against the solids' definitions: inside the sphere, or the box minus the

@@ -88,6 +88,9 @@ struct CrossingOutputs {
     std::span<Real> t;
     std::span<std::uint32_t> object_id;
     std::span<std::uint32_t> primitive_id;
+    /// The hit's surface parameters (2 values a crossing): uv for a scene, the barycentrics of
+    /// corners 1 and 2 for triangles.
+    std::span<Real> uv;
     /// 1 where the ray enters the surface's solid side (direction against the outward
     /// geometric normal), 0 where it leaves. Optional.
     std::span<std::uint8_t> entering;
@@ -127,16 +130,16 @@ struct TriangleStructure {
 template <class Real>
 void intersect(const Scene& scene, const RayArrays<Real>& rays,
                const NearestHitOutputs<Real>& outputs, const BatchConfig& config = {});
-template <class Real>
-void intersect(const TriangleStructure<Real>& mesh, const RayArrays<Real>& rays,
+template <class Real, class SetReal>
+void intersect(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
                const NearestHitOutputs<Real>& outputs, const BatchConfig& config = {});
 
 /// Whether anything is hit in each ray's interval (1) or not (0).
 template <class Real>
 void occluded(const Scene& scene, const RayArrays<Real>& rays, std::span<std::uint8_t> occluded,
               const BatchConfig& config = {});
-template <class Real>
-void occluded(const TriangleStructure<Real>& mesh, const RayArrays<Real>& rays,
+template <class Real, class SetReal>
+void occluded(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
               std::span<std::uint8_t> occluded, const BatchConfig& config = {});
 
 /// How many surface crossings each ray makes in its interval. A scene's crossings are its
@@ -146,8 +149,8 @@ void occluded(const TriangleStructure<Real>& mesh, const RayArrays<Real>& rays,
 template <class Real>
 void count_crossings(const Scene& scene, const RayArrays<Real>& rays,
                      std::span<std::uint32_t> counts, const BatchConfig& config = {});
-template <class Real>
-void count_crossings(const TriangleStructure<Real>& mesh, const RayArrays<Real>& rays,
+template <class Real, class SetReal>
+void count_crossings(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
                      std::span<std::uint32_t> counts, const BatchConfig& config = {});
 
 /// Exclusive prefix sums of `counts` into `offsets` (counts.size() + 1 entries).
@@ -159,8 +162,8 @@ void crossing_offsets(std::span<const std::uint32_t> counts, std::span<std::uint
 template <class Real>
 void list_crossings(const Scene& scene, const RayArrays<Real>& rays,
                     const CrossingOutputs<Real>& outputs, const BatchConfig& config = {});
-template <class Real>
-void list_crossings(const TriangleStructure<Real>& mesh, const RayArrays<Real>& rays,
+template <class Real, class SetReal>
+void list_crossings(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
                     const CrossingOutputs<Real>& outputs, const BatchConfig& config = {});
 
 /// Point membership: 1 where point i is inside a solid object of the scene (Shape::contains:
@@ -171,8 +174,8 @@ void contains(const Scene& scene, const VectorArray<Real>& points, std::span<std
 /// For closed triangle meshes: 1 where the ray from point i along a fixed direction crosses the
 /// surface an odd number of times (crossings counted as count_crossings counts them), as
 /// Open3D's compute_occupancy decides it. Orientation does not matter.
-template <class Real>
-void contains(const TriangleStructure<Real>& mesh, const VectorArray<Real>& points,
+template <class Real, class SetReal>
+void contains(const TriangleStructure<SetReal>& mesh, const VectorArray<Real>& points,
               std::span<std::uint8_t> inside, const BatchConfig& config = {});
 
 /// Where the point queries write, one slot per point (points: 3 values, uv: 2). Optional each.
@@ -191,8 +194,8 @@ struct ClosestPointOutputs {
 };
 
 /// Nearest surface point of each point (the structure's ClosestPointTree, which must be set).
-template <class Real>
-void closest_points(const TriangleStructure<Real>& mesh, const VectorArray<Real>& points,
+template <class Real, class SetReal>
+void closest_points(const TriangleStructure<SetReal>& mesh, const VectorArray<Real>& points,
                     const ClosestPointOutputs<Real>& outputs, const BatchConfig& config = {});
 
 /// The unit geometric normal of triangle i of `set` (its winding's right-hand normal; zero for
