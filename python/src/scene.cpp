@@ -389,6 +389,33 @@ values it rejects, raise ValueError naming the parameter.
         "outward, docs/meshes.md): a closed mesh is a solid. Triangles in float32 unless "
         "double_precision.");
     m.def(
+        "read_mesh",
+        [](const std::string& path) {
+            TriangleMeshData data = [&] {
+                py::gil_scoped_release release;
+                TriangleMeshData loaded = load_mesh(path);
+                return loaded;
+            }();
+            py::array_t<double> vertices(
+                std::vector<py::ssize_t>{static_cast<py::ssize_t>(data.vertices.size()), 3});
+            py::array_t<std::uint32_t> triangles(
+                std::vector<py::ssize_t>{static_cast<py::ssize_t>(data.triangles.size()), 3});
+            double* v = vertices.mutable_data();
+            for (std::size_t i = 0; i < data.vertices.size(); ++i) {
+                for (int k = 0; k < 3; ++k) v[3 * i + k] = data.vertices[i][k];
+            }
+            std::uint32_t* t = triangles.mutable_data();
+            for (std::size_t i = 0; i < data.triangles.size(); ++i) {
+                for (int k = 0; k < 3; ++k) t[3 * i + k] = data.triangles[i][k];
+            }
+            return py::make_tuple(vertices, triangles);
+        },
+        "path"_a,
+        "Reads an OFF, OBJ, PLY or STL file with csgrt's loader and validation (docs/meshes.md: "
+        "degenerate triangles dropped, closed shells oriented outward) and returns (vertices "
+        "(N, 3) float64, triangles (M, 3) uint32), e.g. for RaycastingScene.add_triangles. "
+        "Raises csgrt.MeshError naming the file and what is wrong.");
+    m.def(
         "load_mesh",
         [](const std::string& path, bool double_precision) {
             MeshConfig config;
