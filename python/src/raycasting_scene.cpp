@@ -105,7 +105,7 @@ public:
             next->object_of_triangle.push_back(id);
         }
         next->build();
-        std::lock_guard<std::mutex> swap(pointer_mutex_);
+        std::lock_guard<std::mutex> publish(pointer_mutex_);
         current_ = std::move(next);
         return id;
     }

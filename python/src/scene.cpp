@@ -5,6 +5,7 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <mutex>
 
@@ -39,7 +40,8 @@ std::shared_ptr<const Shape> shape_of(const py::handle& object, const std::strin
 std::vector<std::shared_ptr<const Shape>> shapes_of(const py::args& args, const char* what) {
     std::vector<std::shared_ptr<const Shape>> shapes;
     for (std::size_t i = 0; i < args.size(); ++i) {
-        shapes.push_back(shape_of(args[i], std::string(what) + "[" + std::to_string(i) + "]"));
+        shapes.push_back(
+            shape_of(py::object(args[i]), std::string(what) + "[" + std::to_string(i) + "]"));
     }
     return shapes;
 }
@@ -188,7 +190,7 @@ public:
         SceneConfig config;
         config.accelerator = accelerator;
         next->commit(config);
-        std::lock_guard<std::mutex> swap(pointer_mutex_);
+        std::lock_guard<std::mutex> publish(pointer_mutex_);
         committed_ = std::move(next);
     }
 
@@ -344,7 +346,8 @@ values it rejects, raise ValueError naming the parameter.
         [](const py::list& children, const std::string& accelerator) {
             std::vector<std::shared_ptr<const Shape>> shapes;
             for (std::size_t i = 0; i < children.size(); ++i) {
-                shapes.push_back(shape_of(children[i], "children[" + std::to_string(i) + "]"));
+                shapes.push_back(
+                    shape_of(py::object(children[i]), "children[" + std::to_string(i) + "]"));
             }
             CompoundConfig config;
             config.accelerator = accelerator;
@@ -538,9 +541,9 @@ EXR and its PNG previews as `csgrt render` does. The image does not depend on nt
                 py::gil_scoped_release release;
                 return csgrt::load_scene(path);
             }();
-            PyScene scene(std::move(loaded));
-            scene.commit(accelerator);
-            return scene;
+            auto loaded_scene = std::make_unique<PyScene>(std::move(loaded));
+            loaded_scene->commit(accelerator);
+            return loaded_scene;
         },
         "path"_a, "accelerator"_a = "auto",
         "Reads a JSON scene file (docs/scene-format.md) and commits it: a Scene ready for "
