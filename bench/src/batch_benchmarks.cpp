@@ -71,7 +71,9 @@ void register_batch_trace(Workloads& workloads, const std::string& mesh, const s
             MeshWorkload& workload = workloads.get(mesh);
             const auto triangles = static_cast<double>(workload.triangles());
             const TriangleSet<float>& set = workload.float_set();
-            const TriangleStructure<float> structure{&set, &batch_bvh(mesh, set)};
+            TriangleStructure<float> structure;
+            structure.triangles = &set;
+            structure.structure = &batch_bvh(mesh, set);
             const RayColumns columns(workload.rays(rays).rays);
             const RayArrays<double> view = columns.view();
             const std::size_t n = view.size();

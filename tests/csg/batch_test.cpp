@@ -101,6 +101,19 @@ struct NearestHits {
 };
 
 template <class Real>
+NearestHitOutputs<Real> only_t(std::vector<Real>& t) {
+    NearestHitOutputs<Real> outputs;
+    outputs.t = t;
+    return outputs;
+}
+
+BatchConfig threads(int count) {
+    BatchConfig config;
+    config.threads = count;
+    return config;
+}
+
+template <class Real>
 class BatchTest : public ::testing::Test {};
 using Precisions = ::testing::Types<float, double>;
 TYPED_TEST_SUITE(BatchTest, Precisions);
@@ -257,8 +270,8 @@ TYPED_TEST(BatchTest, TriangleQueriesAgainstTheStructureBruteForceAndMembership)
     intersect(meshes.structure(), buffer.arrays(), all.outputs(), BatchConfig{2, 32});
     // Only t: the same t, and nothing else written.
     std::vector<Real> t_only(n);
-    intersect(meshes.structure(), buffer.arrays(), NearestHitOutputs<Real>{t_only},
-              BatchConfig{1});
+    intersect(meshes.structure(), buffer.arrays(), only_t(t_only),
+              threads(1));
     EXPECT_EQ(t_only, all.t);
 
     QueryScratch scratch;
@@ -317,7 +330,9 @@ TYPED_TEST(BatchTest, TriangleQueriesAgainstTheStructureBruteForceAndMembership)
         const bool expected = sphere.contains(p) ||
                               Aabb(Point3(3, -1, -1), Point3(5, 1, 1)).contains(p);
         // Within 1e-6 of a surface the parity and the reference may disagree on a rounding.
-        if (distance[i] > Real(1e-4)) ASSERT_EQ(inside[i] != 0, expected) << p.transpose();
+        if (distance[i] > Real(1e-4)) {
+            ASSERT_EQ(inside[i] != 0, expected) << p.transpose();
+        }
         in_count += inside[i];
         const ClosestPoint reference = meshes.tree->closest(p);
         ASSERT_EQ(distance[i], static_cast<Real>(std::sqrt(reference.squared_distance)));
@@ -349,16 +364,16 @@ TYPED_TEST(BatchTest, SeparateArraysAndWrongSizesAreRefused) {
     EXPECT_TRUE(a == b);
 
     std::vector<Real> short_t(n - 1);
-    EXPECT_THROW(intersect(scene, soa, NearestHitOutputs<Real>{short_t}), InvalidParameter);
+    EXPECT_THROW(intersect(scene, soa, only_t(short_t)), InvalidParameter);
     std::vector<Real> odd(7);
     EXPECT_THROW(interleaved_vectors<Real>(odd, "origins"), InvalidParameter);
     EXPECT_THROW(separate_vectors<Real>(columns[0], columns[1], short_t, "origins"),
                  InvalidParameter);
     std::vector<Real> t(n);
-    EXPECT_THROW(intersect(scene, soa, NearestHitOutputs<Real>{t}, BatchConfig{-1}),
+    EXPECT_THROW(intersect(scene, soa, only_t(t), threads(-1)),
                  InvalidParameter);
     Scene uncommitted;
-    EXPECT_THROW(intersect(uncommitted, soa, NearestHitOutputs<Real>{t}), InvalidParameter);
+    EXPECT_THROW(intersect(uncommitted, soa, only_t(t)), InvalidParameter);
 }
 
 }  // namespace
