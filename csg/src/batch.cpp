@@ -1,5 +1,6 @@
 #include "csgrt/csg/batch.h"
 
+#include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>

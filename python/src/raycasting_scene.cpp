@@ -4,6 +4,8 @@
 
 #include <pybind11/eigen.h>
 
+#include <Eigen/Geometry>
+
 #include "bindings.h"
 #include "csgrt/accel/factory.h"
 #include "csgrt/accel/mesh.h"
