@@ -98,24 +98,53 @@ def test_meshes_from_arrays_agree_with_the_raycasting_scene():
                                   reference.compute_occupancy(points))
 
 
-def test_scene_file_render_and_exr(tmp_path):
-    scene = csgrt.load_scene(str(SOURCE_DIR / "data/scenes/part_objects.json"))
-    assert scene.object_count > 0
-    image = scene.render(48, 32, spp=1, nthreads=2)
-    assert image["color"].shape == (32, 48, 4) and image["color"].dtype == np.float32
-    assert image["depth"].shape == (32, 48) and image["normal"].shape == (32, 48, 3)
+def test_render_returns_the_aovs_and_writes_the_exr(tmp_path):
+    scene = csgrt.Scene()
+    red = scene.add_material("red", [0.8, 0.1, 0.1])
+    scene.add_object(csgrt.sphere(radius=1), material="red", name="ball")
+    assert red == 1
+    scene.add_point_light([2, 4, 6], 50)
+    scene.set_camera(position=[0, 0, 5], look_at=[0, 0, 0], fov=40)
+    scene.commit()
+    # Odd sizes: the middle pixel's centre ray is the view axis, which meets the unit sphere
+    # at distance 4 with normal +z.
+    image = scene.render(49, 33, spp=1, nthreads=2)
+    assert image["color"].shape == (33, 49, 4) and image["color"].dtype == np.float32
+    assert image["depth"].shape == (33, 49) and image["normal"].shape == (33, 49, 3)
     assert image["object_id"].dtype == np.uint32
+    np.testing.assert_allclose(image["depth"][16, 24], 4.0, rtol=1e-6)  # float32 channel
+    np.testing.assert_allclose(image["normal"][16, 24], [0, 0, 1], atol=1e-6)
     background = image["object_id"] == INVALID_ID
-    assert background.any() and (~background).any()
+    assert background[0, 0] and not background[16, 24]
     assert np.isinf(image["depth"][background]).all()
     assert np.isfinite(image["depth"][~background]).all()
-    assert image["stats"]["primary_rays"] == 48 * 32
+    assert (image["object_id"][~background] == 0).all()
+    assert image["color"][16, 24, 0] > image["color"][16, 24, 2] > 0  # red, lit
+    assert image["stats"]["primary_rays"] == 49 * 33
     # The image does not depend on the thread count.
-    again = scene.render(48, 32, nthreads=1)
+    again = scene.render(49, 33, nthreads=1)
     np.testing.assert_array_equal(again["color"], image["color"])
     path = tmp_path / "frame.exr"
     scene.render(16, 16, exr_path=str(path))
     assert path.stat().st_size > 0 and (tmp_path / "frame.png").exists()
+
+
+def test_scene_files_load_and_answer():
+    scene = csgrt.load_scene(str(SOURCE_DIR / "data/scenes/showcase.json"))
+    assert scene.object_count > 5 and scene.accelerator
+    lower, upper = scene.bounds
+    rng = np.random.default_rng(14)
+    origins = rng.uniform(lower, upper, size=(500, 3))
+    rays = np.hstack([origins, rng.normal(size=(500, 3))])
+    hits = scene.cast_rays(rays)
+    hit = np.isfinite(hits["t_hit"])
+    assert hit.mean() > 0.5
+    assert (hits["geometry_ids"][hit] < scene.object_count).all()
+    np.testing.assert_array_equal(scene.test_occlusions(rays), hit)
+    # The first crossing listed is the nearest hit.
+    listed = scene.list_intersections(rays)
+    first = listed["ray_splits"][:-1][hit]
+    np.testing.assert_array_equal(listed["t_hit"][first], hits["t_hit"][hit])
 
 
 def test_bad_shapes_files_and_uncommitted_scenes():
@@ -154,6 +183,7 @@ def test_objects_added_after_commit_appear_at_the_next_commit():
 
 def test_thread_pool_on_one_scene():
     scene = csgrt.load_scene(str(SOURCE_DIR / "data/scenes/part_objects.json"))
+    assert scene.object_count > 0
     rng = np.random.default_rng(13)
     rays = np.hstack([rng.uniform(-5, 5, size=(3000, 3)), rng.normal(size=(3000, 3))])
     expected = scene.cast_rays(rays, nthreads=1)
