@@ -42,11 +42,14 @@ def read_off(path):
 
 
 def camera_rays(vertices, count):
-    """A square grid of pinhole rays (unit directions, float32 (side, side, 6)) from a point
-    in front of the mesh's box through it, filling the view with the mesh."""
+    """A square grid of pinhole rays (unit directions, float32, (side * side, 6)) through a
+    40-degree view of the mesh."""
     lower, upper = vertices.min(axis=0), vertices.max(axis=0)
-    centre, size = 0.5 * (lower + upper), np.linalg.norm(upper - lower)
-    eye = centre + size * np.array([0.3, 0.25, 1.0]) / np.linalg.norm([0.3, 0.25, 1.0]) * 1.4
+    # As csgrt_bench's framing_camera: from (0.3, 0.25, 1) of the centre, far enough that a
+    # sphere of the box's largest extent fills the 40-degree view's height.
+    centre, extent = 0.5 * (lower + upper), (upper - lower).max()
+    view = np.array([0.3, 0.25, 1.0]) / np.linalg.norm([0.3, 0.25, 1.0])
+    eye = centre + view * 0.5 * extent / np.tan(np.radians(20.0))
     side = int(round(count**0.5))
     forward = (centre - eye) / np.linalg.norm(centre - eye)
     right = np.cross(forward, [0.0, 1.0, 0.0])
