@@ -316,8 +316,10 @@ values it rejects, raise ValueError naming the parameter.
 )doc");
     for (const std::string_view type : scene_shape_types()) {
         if (type == "union" || type == "intersection" || type == "difference" ||
-            type == "compound" || type == "mesh") {
-            continue;  // these take shapes or arrays: bound below
+            type == "compound" || type == "mesh" || type == "ref" || type == "grid") {
+            // Booleans, compounds and meshes take shapes or arrays (bound below); a scene
+            // file's references and grids name definitions, which Python holds as variables.
+            continue;
         }
         const std::string name(type);
         const std::string doc = "Makes a " + name + ": csgrt.shape('" + name +
