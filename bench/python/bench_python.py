@@ -65,14 +65,23 @@ def camera_rays(vertices, count):
 
 
 def best_of(repetitions, run):
-    """Median and min-max of the wall time of `run()` over the repetitions, after one warm-up."""
+    """Median and min-max seconds of `run()` over the repetitions, after one warm-up, and the
+    median process CPU seconds (the measure for one thread: other processes on a shared
+    machine barely change it, as csgrt_bench's one-thread rows)."""
     run()
-    times = []
+    wall, cpu = [], []
     for _ in range(repetitions):
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         run()
-        times.append(time.perf_counter() - start)
-    return float(np.median(times)), float(min(times)), float(max(times))
+        wall.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - start_cpu)
+    return float(np.median(wall)), float(min(wall)), float(max(wall)), float(np.median(cpu))
+
+
+def row(variant, threads, timing):
+    median, lo, hi, cpu = timing
+    return {"variant": variant, "threads": threads, "seconds": median, "min": lo, "max": hi,
+            "cpu_seconds": cpu}
 
 
 def time_csgrt(vertices, triangles, rays, repetitions, threads_list):
@@ -84,10 +93,9 @@ def time_csgrt(vertices, triangles, rays, repetitions, threads_list):
     for threads in threads_list:
         for outputs, label in [(None, "csgrt cast_rays (all outputs)"),
                                (["t_hit", "primitive_ids"], "csgrt cast_rays (t, id)")]:
-            median, lo, hi = best_of(
+            timing = best_of(
                 repetitions, lambda: scene.cast_rays(rays, outputs=outputs, nthreads=threads))
-            rows.append({"variant": label, "threads": threads, "seconds": median,
-                         "min": lo, "max": hi})
+            rows.append(row(label, threads, timing))
     hits = np.isfinite(scene.cast_rays(rays, outputs=["t_hit"])["t_hit"]).mean()
     return rows, float(hits)
 
@@ -102,10 +110,8 @@ def time_peers(vertices, triangles, rays, repetitions, threads_list):
                             o3d.core.Tensor(triangles.astype(np.uint32)))
         tensor = o3d.core.Tensor(rays)
         for threads in threads_list:
-            median, lo, hi = best_of(repetitions,
-                                     lambda: scene.cast_rays(tensor, nthreads=threads))
-            rows.append({"variant": f"open3d {o3d.__version__} cast_rays", "threads": threads,
-                         "seconds": median, "min": lo, "max": hi})
+            timing = best_of(repetitions, lambda: scene.cast_rays(tensor, nthreads=threads))
+            rows.append(row(f"open3d {o3d.__version__} cast_rays", threads, timing))
     except ImportError as error:
         print(f"bench_python: open3d not available ({error})", file=sys.stderr)
     try:
@@ -115,9 +121,8 @@ def time_peers(vertices, triangles, rays, repetitions, threads_list):
         scene = rtcore_scene.EmbreeScene()
         TriangleMesh(scene, vertices.astype(np.float32)[triangles])
         origins, directions = np.ascontiguousarray(rays[:, :3]), np.ascontiguousarray(rays[:, 3:])
-        median, lo, hi = best_of(repetitions, lambda: scene.run(origins, directions, output=1))
-        rows.append({"variant": "embreex run (rtcIntersect1 loop)", "threads": 1,
-                     "seconds": median, "min": lo, "max": hi})
+        timing = best_of(repetitions, lambda: scene.run(origins, directions, output=1))
+        rows.append(row("embreex run (rtcIntersect1 loop)", 1, timing))
     except ImportError as error:
         print(f"bench_python: embreex not available ({error})", file=sys.stderr)
     try:
@@ -125,11 +130,10 @@ def time_peers(vertices, triangles, rays, repetitions, threads_list):
 
         mesh = trimesh.Trimesh(vertices, triangles.astype(np.int64), process=False)
         origins, directions = rays[:, :3].astype(np.float64), rays[:, 3:].astype(np.float64)
-        median, lo, hi = best_of(max(1, repetitions // 5),
-                                 lambda: mesh.ray.intersects_first(origins, directions))
-        rows.append({"variant": f"trimesh {trimesh.__version__} intersects_first "
-                                f"({type(mesh.ray).__module__})", "threads": 1,
-                     "seconds": median, "min": lo, "max": hi})
+        timing = best_of(max(1, repetitions // 5),
+                         lambda: mesh.ray.intersects_first(origins, directions))
+        rows.append(row(f"trimesh {trimesh.__version__} intersects_first "
+                        f"({type(mesh.ray).__module__})", 1, timing))
     except ImportError as error:
         print(f"bench_python: trimesh not available ({error})", file=sys.stderr)
     return rows
@@ -183,12 +187,16 @@ def main():
     print(f"Python ray casting: {len(rays):,} camera rays on {pathlib.Path(args.mesh).name} "
           f"({len(triangles):,} triangles), {hit_fraction:.0%} hit; median of "
           f"{args.repetitions} (min-max); load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f}")
-    print(f"{'variant':58} {'threads':>7} {'Mrays/s':>9}   min-max Mrays/s")
-    for row in rows:
+    print(f"{'variant':58} {'threads':>7} {'Mrays/s':>9}   {'min-max (wall)':>14}  "
+          f"Mrays/s of CPU time")
+    for r in rows:
         n = len(rays) * 1e-6
-        print(f"{row['variant']:58} {row['threads']:>7} {n / row['seconds']:9.2f}   "
-              f"{n / row['max']:.2f}-{n / row['min']:.2f}")
-        row["mrays_per_second"] = n / row["seconds"]
+        r["mrays_per_second"] = n / r["seconds"]
+        r["mrays_per_cpu_second"] = n / r["cpu_seconds"] if r["cpu_seconds"] > 0 else None
+        # One thread: CPU time, as csgrt_bench; several: wall time, the only one that scales.
+        rate = r["mrays_per_cpu_second"] if r["threads"] == 1 else r["mrays_per_second"]
+        print(f"{r['variant']:58} {r['threads']:>7} {rate:9.2f}   "
+              f"{n / r['max']:6.2f}-{n / r['min']:<6.2f}  {n / r['cpu_seconds']:.2f}")
     if args.json:
         pathlib.Path(args.json).write_text(json.dumps(
             {"rays": len(rays), "triangles": len(triangles), "load_average": load,
