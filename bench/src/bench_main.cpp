@@ -137,6 +137,10 @@ void register_all(csgrt::bench::Workloads& workloads, const Settings& settings) 
                 register_trace(workloads, settings, mesh, variant, rays, 1);
             }
         }
+        for (const std::string& rays : ray_sets) {
+            register_batch_trace(workloads, mesh, rays, 1);
+            if (all > 1 && !quick) register_batch_trace(workloads, mesh, rays, all);
+        }
         if (quick) continue;
         for (const Variant& variant : mesh_variants(false, false)) {
             if (variant.is_brute() || all <= 1) continue;

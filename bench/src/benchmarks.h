@@ -54,6 +54,10 @@ std::vector<Variant> mesh_variants(bool with_double, bool with_robust);
 /// "shadow"), with build time, memory and per-ray counts as counters.
 void register_trace(Workloads& workloads, const Settings& settings, const std::string& mesh,
                     const Variant& variant, const std::string& rays, int threads);
+/// trace/<mesh>/bvh-batch/<rays>/threads:<n>: the batch queries (csg/batch.h) over the BVH on
+/// the same rays, beside the single-ray loops (bench/src/batch_benchmarks.cpp).
+void register_batch_trace(Workloads& workloads, const std::string& mesh, const std::string& rays,
+                          int threads);
 /// build/<mesh>/<variant>/threads:<n>: the build alone, repeated.
 void register_build(Workloads& workloads, const std::string& mesh, const Variant& variant,
                     int threads);

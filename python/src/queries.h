@@ -1,0 +1,182 @@
+#pragma once
+
+// The ray and point queries both Python scene classes share, written once over any target the
+// batch functions take (a committed Scene, or a TriangleStructure). Each checks its inputs
+// with the GIL held, allocates its result arrays, releases the GIL for the batch and returns.
+
+#include <string>
+#include <unordered_set>
+
+#include "arrays.h"
+
+namespace csgrt::python {
+
+/// The names cast_rays can return, in Open3D's order (and csgrt's shading normals).
+inline const std::vector<std::string>& cast_ray_outputs() {
+    static const std::vector<std::string> names{"t_hit", "geometry_ids", "primitive_ids",
+                                                "primitive_uvs", "primitive_normals",
+                                                "shading_normals"};
+    return names;
+}
+
+/// Which outputs a call asked for: `requested` is None (Open3D's five) or names.
+std::unordered_set<std::string> requested_outputs(const py::object& requested);
+
+template <class Real, class Target>
+py::dict cast_rays_as(const Target& target, const FloatInput& rays, double tnear, double tfar,
+                      const std::unordered_set<std::string>& wanted, const BatchConfig& config) {
+    const auto& leading = rays.leading;
+    auto t = output<Real>(leading);
+    auto geometry = output<std::uint32_t>(leading);
+    auto primitive = output<std::uint32_t>(leading);
+    auto uv = output<Real>(leading, {2});
+    auto normal = output<Real>(leading, {3});
+    auto shading = output<Real>(leading, {3});
+    NearestHitOutputs<Real> outputs;
+    if (wanted.count("t_hit")) outputs.t = span_of(t);
+    if (wanted.count("geometry_ids")) outputs.object_id = span_of(geometry);
+    if (wanted.count("primitive_ids")) outputs.primitive_id = span_of(primitive);
+    if (wanted.count("primitive_uvs")) outputs.uv = span_of(uv);
+    if (wanted.count("primitive_normals")) outputs.geometric_normal = span_of(normal);
+    if (wanted.count("shading_normals")) outputs.shading_normal = span_of(shading);
+    {
+        py::gil_scoped_release release;
+        intersect(target, ray_arrays<Real>(rays, tnear, tfar), outputs, config);
+    }
+    py::dict result;
+    if (wanted.count("t_hit")) result["t_hit"] = t;
+    if (wanted.count("geometry_ids")) result["geometry_ids"] = geometry;
+    if (wanted.count("primitive_ids")) result["primitive_ids"] = primitive;
+    if (wanted.count("primitive_uvs")) result["primitive_uvs"] = uv;
+    if (wanted.count("primitive_normals")) result["primitive_normals"] = normal;
+    if (wanted.count("shading_normals")) result["shading_normals"] = shading;
+    return result;
+}
+
+template <class Target>
+py::dict cast_rays(const Target& target, const py::handle& rays_object, double tnear,
+                   double tfar, const py::object& requested, int nthreads) {
+    const FloatInput rays = float_input(rays_object, "rays", 6, "(..., 6)");
+    check_interval(tnear, tfar);
+    const auto wanted = requested_outputs(requested);
+    const BatchConfig config = batch_config(nthreads);
+    return rays.is_float32 ? cast_rays_as<float>(target, rays, tnear, tfar, wanted, config)
+                           : cast_rays_as<double>(target, rays, tnear, tfar, wanted, config);
+}
+
+template <class Target>
+py::array_t<bool> test_occlusions(const Target& target, const py::handle& rays_object,
+                                  double tnear, double tfar, int nthreads) {
+    const FloatInput rays = float_input(rays_object, "rays", 6, "(..., 6)");
+    check_interval(tnear, tfar);
+    const BatchConfig config = batch_config(nthreads);
+    auto result = output<bool>(rays.leading);
+    // NumPy's bool is one byte holding 0 or 1: the batch's uint8 answers, in place.
+    const std::span<std::uint8_t> out(reinterpret_cast<std::uint8_t*>(result.mutable_data()),
+                                      rays.count);
+    py::gil_scoped_release release;
+    if (rays.is_float32) {
+        occluded(target, ray_arrays<float>(rays, tnear, tfar), out, config);
+    } else {
+        occluded(target, ray_arrays<double>(rays, tnear, tfar), out, config);
+    }
+    return result;
+}
+
+template <class Target>
+py::array_t<std::int32_t> count_intersections(const Target& target,
+                                              const py::handle& rays_object, double tnear,
+                                              double tfar, int nthreads) {
+    const FloatInput rays = float_input(rays_object, "rays", 6, "(..., 6)");
+    check_interval(tnear, tfar);
+    const BatchConfig config = batch_config(nthreads);
+    auto result = output<std::int32_t>(rays.leading);  // Open3D's dtype
+    // Counts are far below 2^31; signed and unsigned variants of one type may alias.
+    const std::span<std::uint32_t> out(reinterpret_cast<std::uint32_t*>(result.mutable_data()),
+                                       rays.count);
+    py::gil_scoped_release release;
+    if (rays.is_float32) {
+        count_crossings(target, ray_arrays<float>(rays, tnear, tfar), out, config);
+    } else {
+        count_crossings(target, ray_arrays<double>(rays, tnear, tfar), out, config);
+    }
+    return result;
+}
+
+template <class Real, class Target>
+py::dict list_intersections_as(const Target& target, const FloatInput& rays, double tnear,
+                               double tfar, const BatchConfig& config) {
+    const RayArrays<Real> view = ray_arrays<Real>(rays, tnear, tfar);
+    std::vector<std::uint32_t> counts(rays.count);
+    py::array_t<std::uint64_t> splits(static_cast<py::ssize_t>(rays.count + 1));
+    {
+        py::gil_scoped_release release;
+        count_crossings(target, view, std::span<std::uint32_t>(counts), config);
+        crossing_offsets(counts, span_of(splits));
+    }
+    const auto total = static_cast<py::ssize_t>(splits.at(rays.count));
+    py::array_t<std::uint32_t> ray_ids(total), geometry(total), primitive(total);
+    py::array_t<Real> t(total), uv(std::vector<py::ssize_t>{total, 2});
+    py::array_t<bool> entering(total);
+    {
+        py::gil_scoped_release release;
+        auto ids = span_of(ray_ids);
+        const std::uint64_t* offsets = splits.data();
+        for (std::size_t i = 0; i < rays.count; ++i) {
+            for (std::uint64_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+                ids[k] = static_cast<std::uint32_t>(i);
+            }
+        }
+        CrossingOutputs<Real> outputs;
+        outputs.offsets = {offsets, rays.count + 1};
+        outputs.t = span_of(t);
+        outputs.object_id = span_of(geometry);
+        outputs.primitive_id = span_of(primitive);
+        outputs.uv = span_of(uv);
+        outputs.entering = {reinterpret_cast<std::uint8_t*>(entering.mutable_data()),
+                            static_cast<std::size_t>(total)};
+        list_crossings(target, view, outputs, config);
+    }
+    py::dict result;
+    result["ray_splits"] = splits;
+    result["ray_ids"] = ray_ids;
+    result["geometry_ids"] = geometry;
+    result["primitive_ids"] = primitive;
+    result["primitive_uvs"] = uv;
+    result["t_hit"] = t;
+    result["entering"] = entering;
+    return result;
+}
+
+template <class Target>
+py::dict list_intersections(const Target& target, const py::handle& rays_object, double tnear,
+                            double tfar, int nthreads) {
+    const FloatInput rays = float_input(rays_object, "rays", 6, "(..., 6)");
+    check_interval(tnear, tfar);
+    const BatchConfig config = batch_config(nthreads);
+    return rays.is_float32 ? list_intersections_as<float>(target, rays, tnear, tfar, config)
+                           : list_intersections_as<double>(target, rays, tnear, tfar, config);
+}
+
+void check_samples(int nsamples);
+
+template <class Target>
+py::array_t<float> compute_occupancy(const Target& target, const py::handle& points_object,
+                                     int nthreads, int nsamples) {
+    const FloatInput points = float_input(points_object, "query_points", 3, "(..., 3)");
+    check_samples(nsamples);
+    const BatchConfig config = batch_config(nthreads);
+    std::vector<std::uint8_t> inside(points.count);
+    auto result = output<float>(points.leading);  // Open3D's dtype: 0.0 or 1.0
+    auto out = span_of(result);
+    py::gil_scoped_release release;
+    if (points.is_float32) {
+        contains(target, point_arrays<float>(points), std::span<std::uint8_t>(inside), config);
+    } else {
+        contains(target, point_arrays<double>(points), std::span<std::uint8_t>(inside), config);
+    }
+    for (std::size_t i = 0; i < points.count; ++i) out[i] = inside[i] ? 1.0f : 0.0f;
+    return result;
+}
+
+}  // namespace csgrt::python

@@ -1,0 +1,556 @@
+// csgrt.Scene and csgrt.Shape: the whole csgrt scene from Python (analytic shapes, part
+// objects, booleans, instances, meshes, scene files), the same queries as RaycastingScene, and
+// the renderer's AOVs as NumPy arrays.
+
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <mutex>
+
+#include "bindings.h"
+#include "csgrt/accel/mesh.h"
+#include "csgrt/core/error.h"
+#include "csgrt/core/instance.h"
+#include "csgrt/csg/boolean.h"
+#include "csgrt/csg/compound.h"
+#include "csgrt/csg/scene_file.h"
+#include "csgrt/render/exr.h"
+#include "csgrt/render/renderer.h"
+#include "queries.h"
+
+namespace csgrt::python {
+
+namespace {
+
+/// A shape handed to Python: immutable and shared, so one shape may sit in several scenes.
+struct PyShape {
+    std::shared_ptr<const Shape> shape;
+};
+
+std::shared_ptr<const Shape> shape_of(const py::handle& object, const std::string& what) {
+    if (!py::isinstance<PyShape>(object)) {
+        throw py::value_error(what + ": expected a csgrt.Shape, got " +
+                              std::string(py::str(py::type::of(object).attr("__name__"))));
+    }
+    return object.cast<const PyShape&>().shape;
+}
+
+std::vector<std::shared_ptr<const Shape>> shapes_of(const py::args& args, const char* what) {
+    std::vector<std::shared_ptr<const Shape>> shapes;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        shapes.push_back(
+            shape_of(py::object(args[i]), std::string(what) + "[" + std::to_string(i) + "]"));
+    }
+    return shapes;
+}
+
+/// A scene node as the scene file writes it (docs/scene-format.md), through the file's own
+/// reader: every shape type and every parameter check is the file's, with its messages.
+PyShape shape_from_node(const std::string& type, const py::kwargs& params) {
+    using namespace pybind11::literals;
+    py::dict node;
+    node["type"] = type;
+    for (const auto& [key, value] : params) node[key] = value;
+    py::dict document;
+    document["objects"] = py::make_tuple(node);
+    // NumPy arrays and scalars become lists and numbers.
+    const py::object to_plain = py::module_::import("builtins").attr("eval")(
+        "lambda o: o.tolist() if hasattr(o, 'tolist') else str(o)");
+    const std::string text =
+        py::module_::import("json").attr("dumps")(document, "default"_a = to_plain)
+            .cast<std::string>();
+    const Scene scene = load_scene_from_string(text, "csgrt." + type,
+                                               std::filesystem::current_path());
+    if (scene.objects().size() != 1) {
+        throw py::value_error(type + ": makes " + std::to_string(scene.objects().size()) +
+                              " objects; wrap them in csgrt.compound(...)");
+    }
+    return PyShape{scene.objects()[0].shape};
+}
+
+template <class T>
+Eigen::Vector3d vector3(const T& value, const char* what) {
+    const py::array_t<double, py::array::c_style | py::array::forcecast> array =
+        py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+    if (!array || array.size() != 3) {
+        throw py::value_error(std::string(what) + ": expected 3 numbers");
+    }
+    return {array.at(0), array.at(1), array.at(2)};
+}
+
+TriangleMeshData mesh_data(const py::handle& vertices_object, const py::handle& triangles_object) {
+    const FloatInput vertices = float_input(vertices_object, "vertices", 3, "(N, 3)");
+    const py::array triangles_array = py::array::ensure(triangles_object);
+    if (!triangles_array ||
+        (triangles_array.dtype().kind() != 'i' && triangles_array.dtype().kind() != 'u') ||
+        triangles_array.ndim() != 2 || triangles_array.shape(1) != 3) {
+        throw py::value_error("triangles: expected an integer array of shape (M, 3), got " +
+                              (triangles_array ? shape_text(triangles_array) + " " +
+                                                     std::string(py::str(triangles_array.dtype()))
+                                               : std::string("no array")));
+    }
+    const auto indices = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::
+        ensure(triangles_array);
+    TriangleMeshData data;
+    for (std::size_t i = 0; i < vertices.count; ++i) {
+        data.vertices.push_back(vertices.is_float32 ? point_arrays<float>(vertices)[i]
+                                                    : point_arrays<double>(vertices)[i]);
+    }
+    const std::int64_t* index = indices.data();
+    for (py::ssize_t t = 0; t < indices.shape(0); ++t) {
+        std::array<std::uint32_t, 3> triangle{};
+        for (int k = 0; k < 3; ++k) {
+            const std::int64_t v = index[3 * t + k];
+            if (v < 0 || v >= static_cast<std::int64_t>(vertices.count)) {
+                throw py::value_error("triangles: row " + std::to_string(t) +
+                                      " refers to vertex " + std::to_string(v) + ", but there are " +
+                                      std::to_string(vertices.count) + " vertices");
+            }
+            triangle[k] = static_cast<std::uint32_t>(v);
+        }
+        data.triangles.push_back(triangle);
+    }
+    return data;
+}
+
+/// A scene built from Python: objects, materials, lights and camera are added to `building`;
+/// commit() commits a copy and publishes it, and every query reads the last published one. So
+/// adding from one thread while others query is safe, and queries never see a half-built
+/// scene.
+class PyScene {
+public:
+    PyScene() = default;
+    explicit PyScene(Scene scene) : building_(std::move(scene)) {}
+
+    std::uint32_t add_object(const py::handle& shape, const py::object& material,
+                             const std::string& name) {
+        std::uint32_t index = 0;
+        if (py::isinstance<py::str>(material)) {
+            const std::string wanted = material.cast<std::string>();
+            const auto& materials = building_.materials();
+            auto it = std::find_if(materials.begin(), materials.end(),
+                                   [&](const Material& m) { return m.name == wanted; });
+            if (it == materials.end()) {
+                throw py::value_error("material: no material named '" + wanted + "'");
+            }
+            index = static_cast<std::uint32_t>(it - materials.begin());
+        } else {
+            index = material.cast<std::uint32_t>();
+        }
+        std::lock_guard<std::mutex> lock(building_mutex_);
+        return building_.add_object(shape_of(shape, "shape"), index, name);
+    }
+    std::uint32_t add_material(const std::string& name, const py::object& albedo) {
+        std::lock_guard<std::mutex> lock(building_mutex_);
+        return building_.add_material(Material{name, vector3(albedo, "albedo")});
+    }
+    void add_point_light(const py::object& position, const py::object& intensity) {
+        PointLight light;
+        light.position = vector3(position, "position");
+        light.intensity = py::isinstance<py::float_>(intensity) || py::isinstance<py::int_>(intensity)
+                              ? Vector3::Constant(intensity.cast<double>())
+                              : vector3(intensity, "intensity");
+        std::lock_guard<std::mutex> lock(building_mutex_);
+        building_.add_light(light);
+    }
+    void add_directional_light(const py::object& direction, const py::object& radiance) {
+        DirectionalLight light;
+        light.direction = vector3(direction, "direction");
+        light.radiance = py::isinstance<py::float_>(radiance) || py::isinstance<py::int_>(radiance)
+                             ? Vector3::Constant(radiance.cast<double>())
+                             : vector3(radiance, "radiance");
+        std::lock_guard<std::mutex> lock(building_mutex_);
+        building_.add_light(light);
+    }
+    void set_camera(const py::object& position, const py::object& look_at, const py::object& up,
+                    double fov, const std::string& projection, double height) {
+        Camera camera;
+        camera.position = vector3(position, "position");
+        camera.look_at = vector3(look_at, "look_at");
+        camera.up = vector3(up, "up");
+        camera.vertical_fov_degrees = fov;
+        camera.orthographic_height = height;
+        if (projection == "orthographic") {
+            camera.projection = Camera::Projection::Orthographic;
+        } else if (projection != "pinhole") {
+            throw py::value_error("projection: expected 'pinhole' or 'orthographic', got '" +
+                                  projection + "'");
+        }
+        camera.validate();
+        std::lock_guard<std::mutex> lock(building_mutex_);
+        building_.set_camera(camera);
+    }
+
+    void commit(const std::string& accelerator) {
+        py::gil_scoped_release release;
+        std::lock_guard<std::mutex> lock(building_mutex_);
+        auto next = std::make_shared<Scene>(building_);
+        SceneConfig config;
+        config.accelerator = accelerator;
+        next->commit(config);
+        std::lock_guard<std::mutex> publish(pointer_mutex_);
+        committed_ = std::move(next);
+    }
+
+    /// The last committed scene; ValueError before the first commit.
+    std::shared_ptr<const Scene> committed() const {
+        std::lock_guard<std::mutex> lock(pointer_mutex_);
+        if (!committed_) {
+            throw py::value_error("scene: not committed; call commit() after adding objects");
+        }
+        return committed_;
+    }
+    std::size_t object_count() const {
+        std::lock_guard<std::mutex> lock(building_mutex_);
+        return building_.objects().size();
+    }
+
+private:
+    mutable std::mutex building_mutex_;
+    Scene building_;
+    mutable std::mutex pointer_mutex_;
+    std::shared_ptr<const Scene> committed_;
+};
+
+py::dict render_scene(const PyScene& self, int width, int height, int spp, int nthreads,
+                      std::uint64_t seed, const py::object& exr_path) {
+    const auto scene = self.committed();
+    RenderSettings settings;
+    settings.width = width;
+    settings.height = height;
+    settings.samples_per_pixel = spp;
+    settings.threads = nthreads;
+    settings.seed = seed;
+    validate(settings);
+    RenderResult result;
+    {
+        py::gil_scoped_release release;
+        result = render(*scene, settings);
+    }
+    const auto h = static_cast<py::ssize_t>(height), w = static_cast<py::ssize_t>(width);
+    py::array_t<float> color(std::vector<py::ssize_t>{h, w, 4});
+    py::array_t<float> depth(std::vector<py::ssize_t>{h, w});
+    py::array_t<float> normal(std::vector<py::ssize_t>{h, w, 3});
+    py::array_t<std::uint32_t> object_id(std::vector<py::ssize_t>{h, w});
+    py::array_t<float> cost(std::vector<py::ssize_t>{h, w});
+    float* c = color.mutable_data();
+    float* d = depth.mutable_data();
+    float* n = normal.mutable_data();
+    std::uint32_t* id = object_id.mutable_data();
+    float* k = cost.mutable_data();
+    const auto& pixels = result.image.pixels();
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+        const Pixel& p = pixels[i];
+        c[4 * i] = p.red, c[4 * i + 1] = p.green, c[4 * i + 2] = p.blue, c[4 * i + 3] = p.alpha;
+        d[i] = p.depth;
+        n[3 * i] = p.normal_x, n[3 * i + 1] = p.normal_y, n[3 * i + 2] = p.normal_z;
+        id[i] = p.object_id;
+        k[i] = p.cost;
+    }
+    if (!exr_path.is_none()) {
+        ExrMetadata metadata;
+        metadata.camera = scene->camera();
+        metadata.accelerator = std::string(scene->accelerator_name());
+        metadata.accelerator_build_milliseconds = scene->accelerator_stats().build_milliseconds;
+        metadata.samples_per_pixel = spp;
+        const std::filesystem::path path = py::str(exr_path).cast<std::string>();
+        py::gil_scoped_release release;
+        write_render_files(path, result.image, metadata);
+    }
+    py::dict out;
+    out["color"] = color;
+    out["depth"] = depth;
+    out["normal"] = normal;
+    out["object_id"] = object_id;
+    out["cost"] = cost;
+    py::dict stats;
+    stats["primary_rays"] = result.stats.primary_rays;
+    stats["shadow_rays"] = result.stats.shadow_rays;
+    stats["seconds"] = result.stats.seconds;
+    out["stats"] = stats;
+    return out;
+}
+
+}  // namespace
+
+void bind_scene(py::module_& m) {
+    using namespace pybind11::literals;
+    py::class_<PyShape>(m, "Shape", R"doc(
+A csgrt shape: an analytic primitive, part object, mesh, boolean, compound or instance.
+Immutable and shareable: the same shape may be added to several scenes and nested in several
+booleans. Made by csgrt.shape(), the functions named after each shape type (csgrt.sphere,
+csgrt.box, ...), csgrt.union / intersection / difference, csgrt.compound, csgrt.instance,
+csgrt.mesh and csgrt.load_mesh.
+)doc")
+        .def_property_readonly(
+            "kind", [](const PyShape& s) { return std::string(s.shape->kind()); },
+            "The shape's kind: 'sphere', 'difference', 'mesh', 'instance', ...")
+        .def_property_readonly(
+            "is_solid", [](const PyShape& s) { return s.shape->is_solid(); },
+            "Whether the shape is a closed solid (a boolean operand, with inside and outside).")
+        .def_property_readonly(
+            "bounds",
+            [](const PyShape& s) {
+                const Aabb box = s.shape->bounds();
+                return py::make_tuple(Eigen::Vector3d(box.lower), Eigen::Vector3d(box.upper));
+            },
+            "(lower, upper) corners of the shape's bounding box (infinite for planes).")
+        .def(
+            "contains",
+            [](const PyShape& s, const py::object& point) {
+                return s.shape->contains(vector3(point, "point"));
+            },
+            "point"_a, "Whether the point (3 numbers) is inside the solid (False for surfaces).")
+        .def("__repr__", [](const PyShape& s) {
+            return "<csgrt.Shape " + std::string(s.shape->kind()) + ">";
+        });
+
+    m.def("shape", &shape_from_node, "type"_a, R"doc(
+Makes a shape from its scene-file type and keyword parameters, exactly as a scene file's node
+(docs/scene-format.md): lengths in the scene's units, angles in degrees, points and vectors as
+3 numbers (lists or arrays), an optional ``transform`` list. For example
+``csgrt.shape("part_sphere", radius=1, phi_max=270)``. Parameters the type does not take, or
+values it rejects, raise ValueError naming the parameter.
+)doc");
+    for (const std::string_view type : scene_shape_types()) {
+        if (type == "union" || type == "intersection" || type == "difference" ||
+            type == "compound" || type == "mesh" || type == "ref" || type == "grid") {
+            // Booleans, compounds and meshes take shapes or arrays (bound below); a scene
+            // file's references and grids name definitions, which Python holds as variables.
+            continue;
+        }
+        const std::string name(type);
+        const std::string doc = "Makes a " + name + ": csgrt.shape('" + name +
+                                "', **params), with the scene file's parameter names "
+                                "(docs/scene-format.md, docs/python.md).";
+        m.def(
+            name.c_str(),
+            [name](const py::kwargs& params) { return shape_from_node(name, params); },
+            doc.c_str());
+    }
+    m.def(
+        "union", [](const py::args& args) { return PyShape{make_union(shapes_of(args, "operands"))}; },
+        "The union of two or more solids (a balanced tree of CSG unions).");
+    m.def(
+        "intersection",
+        [](const py::args& args) { return PyShape{make_intersection(shapes_of(args, "operands"))}; },
+        "The intersection of two or more solids.");
+    m.def(
+        "difference",
+        [](const py::object& first, const py::args& args) {
+            return PyShape{make_difference(shape_of(first, "first"), shapes_of(args, "subtracted"))};
+        },
+        "first"_a, "The first solid minus every other one: difference(a, b, c) = a - (b | c).");
+    m.def(
+        "compound",
+        [](const py::list& children, const std::string& accelerator) {
+            std::vector<std::shared_ptr<const Shape>> shapes;
+            for (std::size_t i = 0; i < children.size(); ++i) {
+                shapes.push_back(
+                    shape_of(py::object(children[i]), "children[" + std::to_string(i) + "]"));
+            }
+            CompoundConfig config;
+            config.accelerator = accelerator;
+            return PyShape{std::make_shared<Compound>(std::move(shapes), config)};
+        },
+        "children"_a, "accelerator"_a = "auto",
+        "A plain group of shapes with a structure over them (no boolean): the nearest hit of "
+        "any child. accelerator: 'auto' or a structure name ('bvh', 'grid', ...).");
+    m.def(
+        "instance",
+        [](const py::object& shape, const py::object& matrix) {
+            const auto array =
+                py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(matrix);
+            if (!array || array.ndim() != 2 || array.shape(1) != 4 ||
+                (array.shape(0) != 3 && array.shape(0) != 4)) {
+                throw py::value_error("matrix: expected an array of shape (4, 4) or (3, 4), got " +
+                                      (array ? shape_text(array) : std::string("no array")));
+            }
+            Eigen::Matrix4d m4 = Eigen::Matrix4d::Identity();
+            for (py::ssize_t r = 0; r < array.shape(0); ++r) {
+                for (int c = 0; c < 4; ++c) m4(r, c) = array.at(r, c);
+            }
+            return PyShape{std::make_shared<Instance>(shape_of(shape, "shape"),
+                                                      Transform::from_matrix(m4))};
+        },
+        "shape"_a, "matrix"_a,
+        "The shape under an affine transform: matrix (4, 4) or (3, 4) maps the shape's space to "
+        "the world (world_from_object), points as column vectors. Rays are not renormalised, "
+        "so t is the same in both spaces.");
+    m.def(
+        "mesh",
+        [](const py::handle& vertices, const py::handle& triangles, bool double_precision) {
+            MeshConfig config;
+            config.double_precision = double_precision;
+            auto data = mesh_data(vertices, triangles);
+            py::gil_scoped_release release;
+            return PyShape{std::make_shared<Mesh>(std::move(data), config)};
+        },
+        "vertices"_a, "triangles"_a, "double_precision"_a = false,
+        "A triangle mesh shape from arrays: vertices (N, 3), triangles (M, 3) integer indices. "
+        "Validated as mesh files are (degenerate triangles dropped, closed shells oriented "
+        "outward, docs/meshes.md): a closed mesh is a solid. Triangles in float32 unless "
+        "double_precision.");
+    m.def(
+        "read_mesh",
+        [](const std::string& path) {
+            TriangleMeshData data = [&] {
+                py::gil_scoped_release release;
+                TriangleMeshData loaded = load_mesh(path);
+                return loaded;
+            }();
+            py::array_t<double> vertices(
+                std::vector<py::ssize_t>{static_cast<py::ssize_t>(data.vertices.size()), 3});
+            py::array_t<std::uint32_t> triangles(
+                std::vector<py::ssize_t>{static_cast<py::ssize_t>(data.triangles.size()), 3});
+            double* v = vertices.mutable_data();
+            for (std::size_t i = 0; i < data.vertices.size(); ++i) {
+                for (int k = 0; k < 3; ++k) v[3 * i + k] = data.vertices[i][k];
+            }
+            std::uint32_t* t = triangles.mutable_data();
+            for (std::size_t i = 0; i < data.triangles.size(); ++i) {
+                for (int k = 0; k < 3; ++k) t[3 * i + k] = data.triangles[i][k];
+            }
+            return py::make_tuple(vertices, triangles);
+        },
+        "path"_a,
+        "Reads an OFF, OBJ, PLY or STL file with csgrt's loader and validation (docs/meshes.md: "
+        "degenerate triangles dropped, closed shells oriented outward) and returns (vertices "
+        "(N, 3) float64, triangles (M, 3) uint32), e.g. for RaycastingScene.add_triangles. "
+        "Raises csgrt.MeshError naming the file and what is wrong.");
+    m.def(
+        "load_mesh",
+        [](const std::string& path, bool double_precision) {
+            MeshConfig config;
+            config.double_precision = double_precision;
+            py::gil_scoped_release release;
+            return PyShape{Mesh::load(path, config)};
+        },
+        "path"_a, "double_precision"_a = false,
+        "A mesh shape from an OFF, OBJ, PLY or STL file (docs/meshes.md). Raises "
+        "csgrt.MeshError naming the file and what is wrong.");
+
+    py::class_<PyScene> scene(m, "Scene", R"doc(
+A csgrt scene: objects (any csgrt.Shape: analytic solids, CSG trees, instances, meshes),
+materials, lights and a camera. Add objects, call commit(), then query: the queries have
+RaycastingScene's names and results (geometry_ids are object ids) and work on every kind of
+shape. Objects added after commit() are seen by queries after the next commit().
+)doc");
+    scene.def(py::init<>(), "An empty scene with the default camera and material 0 ('default').");
+    scene.def("add_object", &PyScene::add_object, "shape"_a, "material"_a = 0, "name"_a = "",
+              "Adds a shape as a top-level object; returns its object id. material: an index "
+              "from add_material or a material name.");
+    scene.def("add_material", &PyScene::add_material, "name"_a, "albedo"_a,
+              "Adds a Lambertian material (linear RGB albedo in [0, 1]); returns its index.");
+    scene.def("add_point_light", &PyScene::add_point_light, "position"_a, "intensity"_a = 100.0,
+              "A point light (intensity: a number or RGB, radiance times squared distance).");
+    scene.def("add_directional_light", &PyScene::add_directional_light, "direction"_a,
+              "radiance"_a = 1.0, "Light arriving along `direction` from infinitely far away.");
+    scene.def("set_camera", &PyScene::set_camera, "position"_a, "look_at"_a,
+              "up"_a = py::make_tuple(0.0, 1.0, 0.0), "fov"_a = 40.0,
+              "projection"_a = "pinhole", "height"_a = 2.0,
+              "The camera render() looks through: fov is the vertical field of view in "
+              "degrees (pinhole), height the view's height (orthographic).");
+    scene.def("commit", &PyScene::commit, "accelerator"_a = "auto",
+              "Builds the bounds and the structure over the objects (accelerator: 'auto' or "
+              "a structure name) and makes this state the one queries see.");
+    scene.def_property_readonly("object_count", &PyScene::object_count,
+                                "Objects added so far.");
+    scene.def_property_readonly(
+        "bounds",
+        [](const PyScene& self) {
+            const Aabb box = self.committed()->bounds();
+            return py::make_tuple(Eigen::Vector3d(box.lower), Eigen::Vector3d(box.upper));
+        },
+        "(lower, upper) of the committed scene's bounded objects.");
+    scene.def_property_readonly(
+        "accelerator",
+        [](const PyScene& self) { return std::string(self.committed()->accelerator_name()); },
+        "The structure commit() chose over the objects.");
+
+    const std::string rays_doc = std::string(kRaysDoc) +
+                                 "\ntnear, tfar: the interval of t searched (closed).\n" +
+                                 kThreadsDoc;
+    scene.def(
+        "cast_rays",
+        [](const PyScene& self, const py::handle& rays, double tnear, double tfar,
+           const py::object& outputs, int nthreads) {
+            const auto committed = self.committed();
+            return cast_rays(*committed, rays, tnear, tfar, outputs, nthreads);
+        },
+        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "outputs"_a = py::none(),
+        "nthreads"_a = 0,
+        ("The nearest hit of every ray, as RaycastingScene.cast_rays: t_hit, geometry_ids "
+         "(object ids), primitive_ids (the leaf's own sub-primitive: triangle, box face, cap), "
+         "primitive_uvs (the surface's uv), primitive_normals (geometric, outward for solids) "
+         "and, when asked for in outputs, shading_normals (interpolated on meshes).\n" +
+         rays_doc).c_str());
+    scene.def(
+        "test_occlusions",
+        [](const PyScene& self, const py::handle& rays, double tnear, double tfar, int nthreads) {
+            const auto committed = self.committed();
+            return test_occlusions(*committed, rays, tnear, tfar, nthreads);
+        },
+        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
+        ("Whether anything is hit in [tnear, tfar] along each ray (bool array).\n" + rays_doc)
+            .c_str());
+    scene.def(
+        "count_intersections",
+        [](const PyScene& self, const py::handle& rays, double tnear, double tfar, int nthreads) {
+            const auto committed = self.committed();
+            return count_intersections(*committed, rays, tnear, tfar, nthreads);
+        },
+        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
+        ("How many surfaces each ray crosses in [tnear, tfar] (int32): its successive nearest "
+         "hits, each searched just beyond the last, so coincident surfaces count once.\n" +
+         rays_doc).c_str());
+    scene.def(
+        "list_intersections",
+        [](const PyScene& self, const py::handle& rays, double tnear, double tfar, int nthreads) {
+            const auto committed = self.committed();
+            return list_intersections(*committed, rays, tnear, tfar, nthreads);
+        },
+        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
+        ("Every crossing, as RaycastingScene.list_intersections; `entering` is True where the "
+         "ray arrives on the side the surface's normal points to (into a solid).\n" + rays_doc)
+            .c_str());
+    scene.def(
+        "compute_occupancy",
+        [](const PyScene& self, const py::handle& points, int nthreads, int nsamples) {
+            const auto committed = self.committed();
+            return compute_occupancy(*committed, points, nthreads, nsamples);
+        },
+        "query_points"_a, "nthreads"_a = 0, "nsamples"_a = 1,
+        ("1.0 where a point is inside a solid object (CSG trees, analytic solids, closed "
+         "meshes; each solid's own exact membership test), 0.0 elsewhere (float32).\n"
+         "nsamples: must be 1.\n" + std::string(kPointsDoc) + "\n" + kThreadsDoc).c_str());
+    scene.def("render", &render_scene, "width"_a, "height"_a, "spp"_a = 1, "nthreads"_a = 0,
+              "seed"_a = 0, "exr_path"_a = py::none(), R"doc(
+Renders the committed scene through its camera (docs/rendering.md) and returns a dict of
+arrays, rows from the top: ``color`` (height, width, 4) float32 linear RGBA, premultiplied;
+``depth`` (height, width) float32, inf for background; ``normal`` (height, width, 3);
+``object_id`` (height, width) uint32, 2**32 - 1 for background; ``cost`` (height, width); and
+``stats`` (primary_rays, shadow_rays, seconds). With exr_path, also writes the multi-channel
+EXR and its PNG previews as `csgrt render` does. The image does not depend on nthreads.
+)doc");
+
+    m.def(
+        "load_scene",
+        [](const std::string& path, const std::string& accelerator) {
+            Scene loaded = [&] {
+                py::gil_scoped_release release;
+                return csgrt::load_scene(path);
+            }();
+            auto loaded_scene = std::make_unique<PyScene>(std::move(loaded));
+            loaded_scene->commit(accelerator);
+            return loaded_scene;
+        },
+        "path"_a, "accelerator"_a = "auto",
+        "Reads a JSON scene file (docs/scene-format.md) and commits it: a Scene ready for "
+        "queries and render(). Raises csgrt.SceneError naming the file, the place in it and "
+        "what was expected.");
+}
+
+}  // namespace csgrt::python
