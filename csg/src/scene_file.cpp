@@ -116,6 +116,23 @@ std::string describe(const Json& value) {
     }
 }
 
+/// A pointer for a message: a very deep one (the nesting limits are met 500 levels down)
+/// keeps its first and last 120 characters around the count of the levels left out.
+std::string shown_pointer(const std::string& pointer) {
+    if (pointer.empty()) return "(top level)";
+    constexpr std::size_t kKept = 120;
+    if (pointer.size() <= 3 * kKept) return pointer;
+    const std::size_t head = pointer.find('/', kKept);
+    const std::size_t tail = pointer.rfind('/', pointer.size() - kKept);
+    if (head == std::string::npos || tail == std::string::npos || tail <= head) return pointer;
+    const auto levels = std::count(pointer.begin() + static_cast<std::ptrdiff_t>(head),
+                                   pointer.begin() + static_cast<std::ptrdiff_t>(tail), '/');
+    std::string text = pointer.substr(0, head);
+    text.append("/...(").append(std::to_string(levels)).append(" levels)...");
+    text.append(pointer.substr(tail));
+    return text;
+}
+
 /// Where in which file: everything a message needs besides what went wrong.
 struct Source {
     std::string name;
@@ -127,8 +144,7 @@ struct Source {
         for (char& c : text) {
             if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
         }
-        throw SceneError(name + ": " + (pointer.empty() ? std::string("(top level)") : pointer) +
-                         ": " + text);
+        throw SceneError(name + ": " + shown_pointer(pointer) + ": " + text);
     }
 };
 
@@ -577,13 +593,22 @@ std::string known_types() {
     return known;
 }
 
+/// The parameter an InvalidParameter names: "What: parameter must be ...".
+std::string parameter_of(const InvalidParameter& error) {
+    const std::string_view message = error.what();
+    const auto colon = message.find(": ");
+    const auto must = message.find(" must be ");
+    if (colon == std::string_view::npos || must == std::string_view::npos || must < colon) return {};
+    return std::string(message.substr(colon + 2, must - colon - 2));
+}
+
 /// Turns a shape's InvalidParameter ("Sphere: radius must be > 0 ...") into a SceneError at the
 /// key the message names, when the node has that key, else at the node.
 [[noreturn]] void rethrow_invalid(const InvalidParameter& error, const Fields& fields,
                                   const Json& node, bool angles) {
     std::string message = error.what();
     std::string pointer = fields.pointer();
-    std::string parameter = error.parameter();
+    std::string parameter = parameter_of(error);
     // The structure name of a compound or grid is its "accelerator" key; the keys every node
     // may have are never a shape's parameter.
     if (message.starts_with("make_accelerator:") && parameter == "name") parameter = "accelerator";
@@ -598,6 +623,20 @@ std::string known_types() {
     fields.source().fail(pointer, message);
 }
 
+/// The shapes `shape` is made of: an instance's shape, a boolean's operands, a compound's
+/// children; none for a leaf.
+std::vector<const Shape*> children_of(const Shape& shape) {
+    if (const auto* instance = dynamic_cast<const Instance*>(&shape)) return {&instance->shape()};
+    if (const auto* node = dynamic_cast<const Boolean*>(&shape)) {
+        return {&node->first(), &node->second()};
+    }
+    std::vector<const Shape*> children;
+    if (const auto* compound = dynamic_cast<const Compound*>(&shape)) {
+        for (const auto& child : compound->children()) children.push_back(child.get());
+    }
+    return children;
+}
+
 /// `value` plus `add`, saturating at the largest count rather than wrapping.
 std::uint64_t saturating_add(std::uint64_t value, std::uint64_t add) {
     return add > std::numeric_limits<std::uint64_t>::max() - value
@@ -610,7 +649,7 @@ std::uint64_t saturating_add(std::uint64_t value, std::uint64_t add) {
 std::uint64_t expanded_leaves(const Shape& shape,
                               std::unordered_map<const Shape*, std::uint64_t>& memo) {
     if (const auto found = memo.find(&shape); found != memo.end()) return found->second;
-    const std::vector<const Shape*> children = shape.children();
+    const std::vector<const Shape*> children = children_of(shape);
     std::uint64_t leaves = children.empty() ? 1 : 0;
     for (const Shape* child : children) leaves = saturating_add(leaves, expanded_leaves(*child, memo));
     memo.emplace(&shape, leaves);
@@ -649,11 +688,13 @@ void require_representable(const Transform& transform, const Source& source, con
 /// is not): the shading and the camera square lengths and normalise.
 void require_length(const Vector3& v, Fields& fields, std::string_view key, std::string_view what,
                     bool direction) {
-    const double length = v.norm();
+    // stableNorm scales first, so the length it reports is the true one, not an overflow.
+    const double length = v.stableNorm();
     if (!(length <= kMaxLength)) {
-        fields.fail(key, std::string(what) + " has length " + detail::describe(length) +
-                             ", beyond " + detail::describe(kMaxLength) +
-                             ": its square overflows a double in the shading");
+        char text[32];
+        std::snprintf(text, sizeof text, "%.6g", length);
+        fields.fail(key, std::string(what) + " has length " + text +
+                             ", beyond 1e150: its square overflows a double in the shading");
     }
     if (direction && v.squaredNorm() < DBL_MIN) {
         fields.fail(key, std::string(what) + " " + detail::describe(v) +
@@ -747,6 +788,14 @@ std::vector<ShapePointer> Loader::grid(Fields& fields) {
     const Vector3 spacing = fields.vector("spacing");
     const ShapePointer item =
         shape(fields.required("item", "a shape node"), fields.pointer("item"), "a grid item");
+    // Refused before the copies are made: a grid of grids is a product.
+    const std::uint64_t item_leaves = expanded_leaves(*item, leaves_);
+    if (item_leaves > kMaxExpandedLeaves / total) {
+        fields.fail("count", std::to_string(total) + " copies of an item of " +
+                                 std::to_string(item_leaves) + " leaf shapes are more than the " +
+                                 std::to_string(kMaxExpandedLeaves) +
+                                 " leaves a scene may expand to (docs/scene-format.md, Limits)");
+    }
     Transform placement;
     if (fields.has("transform")) {
         placement =
@@ -931,8 +980,11 @@ void Loader::camera(Scene& scene) {
         require_length(camera.position, fields, "position", "the position", false);
         require_length(camera.look_at, fields, "look_at", "look_at", false);
         require_length(camera.up, fields, "up", "the up vector", true);
-        require_length(camera.look_at - camera.position, fields, "look_at",
-                       "the view direction look_at - position", true);
+        // look_at == position is Camera::validate's to report.
+        if (camera.look_at != camera.position) {
+            require_length(camera.look_at - camera.position, fields, "look_at",
+                           "the view direction look_at - position", true);
+        }
         try {
             camera.validate();
         } catch (const InvalidParameter& error) {
@@ -1236,7 +1288,7 @@ Scene load_scene(const std::filesystem::path& path) {
     std::error_code error;
     const auto status = std::filesystem::status(path, error);
     if (!std::filesystem::exists(status)) {
-        throw SceneError(path.string() + ": no such file");
+        throw SceneError(path.string() + ": cannot open the scene file (no such file)");
     }
     if (!std::filesystem::is_regular_file(status)) {
         const char* kind = std::filesystem::is_directory(status) ? "a directory"
@@ -1290,7 +1342,7 @@ NodeCounts count_node(const Shape& shape, std::unordered_map<const Shape*, NodeC
     if (const auto found = memo.find(&shape); found != memo.end()) return found->second;
     NodeCounts counts;
     counts.kinds[shape.kind()] = 1;
-    const std::vector<const Shape*> children = shape.children();
+    const std::vector<const Shape*> children = children_of(shape);
     if (children.empty()) {
         counts.leaves = 1;
         // The one leaf kind with parts of its own.

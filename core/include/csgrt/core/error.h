@@ -8,7 +8,6 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
-#include <utility>
 
 namespace csgrt {
 
@@ -17,16 +16,6 @@ namespace csgrt {
 class InvalidParameter : public std::invalid_argument {
 public:
     using std::invalid_argument::invalid_argument;
-    /// The message, and the name of the parameter it is about as the thrower spells it.
-    InvalidParameter(const std::string& message, std::string parameter)
-        : std::invalid_argument(message), parameter_(std::move(parameter)) {}
-
-    /// The parameter's name ("radius", "phi_min", "look_at"), so a caller such as the scene
-    /// loader can point at its own key without parsing the message; empty when none was named.
-    const std::string& parameter() const { return parameter_; }
-
-private:
-    std::string parameter_;
 };
 
 namespace detail {
@@ -53,7 +42,7 @@ void require(bool ok, std::string_view what, std::string_view parameter,
     std::string message;
     message.append(what).append(": ").append(parameter).append(" must be ");
     message.append(expectation).append(", got ").append(detail::describe(value));
-    throw InvalidParameter(message, std::string(parameter));
+    throw InvalidParameter(message);
 }
 
 /// `require` for the common case of a strictly positive, finite length.

@@ -19,7 +19,6 @@ public:
     std::string_view kind() const override { return "instance"; }
     Aabb bounds() const override { return bounds_; }
     bool is_solid() const override { return shape_->is_solid(); }
-    std::vector<const Shape*> children() const override { return {shape_.get()}; }
 
     bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
     bool any_hit(const Ray& ray, QueryScratch& scratch) const override;

@@ -2,7 +2,6 @@
 
 #include <optional>
 #include <string_view>
-#include <vector>
 
 #include "csgrt/core/aabb.h"
 #include "csgrt/core/hit.h"
@@ -40,11 +39,6 @@ public:
     /// True for closed solids: `find_spans` and `contains` are defined and the shape may be a
     /// CSG operand.
     virtual bool is_solid() const { return false; }
-
-    /// The shapes this one is made of, in its own order (an instance's shape, a boolean's two
-    /// operands, a compound's children); empty for a leaf. For tools that walk the tree (the
-    /// scene's shape counts), never for queries: it allocates.
-    virtual std::vector<const Shape*> children() const { return {}; }
 
     /// Finds the nearest hit with t in [ray.t_min, ray.t_max]. On success overwrites `record`
     /// (every field) and returns true; otherwise leaves `record` alone. Callers narrow

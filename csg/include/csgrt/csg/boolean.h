@@ -27,7 +27,6 @@ public:
 
     /// "union", "intersection" or "difference".
     std::string_view kind() const override;
-    std::vector<const Shape*> children() const override { return {first_.get(), second_.get()}; }
     Aabb bounds() const override { return bounds_; }
     bool is_solid() const override { return true; }
 
