@@ -125,10 +125,10 @@ std::string in_mebibytes(std::uint64_t bytes) {
     return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB";
 }
 
-/// The machine's physical memory, or `configured` when set.
+/// The machine's free memory now, or `configured` when set.
 std::uint64_t memory_available(std::uint64_t configured) {
     if (configured > 0) return configured;
-    const long pages = ::sysconf(_SC_PHYS_PAGES);
+    const long pages = ::sysconf(_SC_AVPHYS_PAGES);
     const long page_size = ::sysconf(_SC_PAGESIZE);
     if (pages <= 0 || page_size <= 0) return std::numeric_limits<std::uint64_t>::max();
     return std::uint64_t(pages) * std::uint64_t(page_size);
@@ -207,7 +207,7 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
         throw UsageError("a " + std::to_string(options.width) + "x" +
                          std::to_string(options.height) + " image needs about " +
                          in_mebibytes(needed) + ", more than the " + in_mebibytes(available) +
-                         " of memory here; render a smaller image");
+                         " of memory free here; render a smaller image");
     }
 
     Scene scene = load_checked(options.scene);

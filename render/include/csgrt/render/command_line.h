@@ -14,7 +14,7 @@ struct CommandLineStreams {
     std::ostream& err;
     bool err_is_terminal = false;
     double progress_delay_seconds = 1.0;
-    /// Memory a render's image may take; 0 means the machine's physical memory. A larger
+    /// Memory a render's image may take; 0 means the machine's free memory at the start. A larger
     /// image is refused before rendering, with the estimate.
     std::uint64_t memory_bytes = 0;
 };
