@@ -876,9 +876,10 @@ void scan_stl_ascii(std::istream& in, Expectation& expect) {
             // one mesh, as OpenMesh and assimp read them.
             if (!lines.next_nonblank()) break;
             if (lines.tokens()[0] != "solid") {
-                problem_at_line(lines.number(), "expected 'solid' or the end of the file after "
-                                                "'endsolid', found " +
-                                                    shown(lines.tokens()[0]));
+                problem_at_line(lines.number(),
+                                "expected 'solid' or the end of the file after "
+                                "'endsolid', found " +
+                                    shown(lines.tokens()[0]));
             }
             continue;
         }

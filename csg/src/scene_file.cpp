@@ -598,7 +598,8 @@ std::string parameter_of(const InvalidParameter& error) {
     const std::string_view message = error.what();
     const auto colon = message.find(": ");
     const auto must = message.find(" must be ");
-    if (colon == std::string_view::npos || must == std::string_view::npos || must < colon) return {};
+    if (colon == std::string_view::npos || must == std::string_view::npos || must < colon)
+        return {};
     return std::string(message.substr(colon + 2, must - colon - 2));
 }
 
@@ -651,7 +652,8 @@ std::uint64_t expanded_leaves(const Shape& shape,
     if (const auto found = memo.find(&shape); found != memo.end()) return found->second;
     const std::vector<const Shape*> children = children_of(shape);
     std::uint64_t leaves = children.empty() ? 1 : 0;
-    for (const Shape* child : children) leaves = saturating_add(leaves, expanded_leaves(*child, memo));
+    for (const Shape* child : children)
+        leaves = saturating_add(leaves, expanded_leaves(*child, memo));
     memo.emplace(&shape, leaves);
     return leaves;
 }
@@ -717,8 +719,8 @@ ShapePointer Loader::shape(Fields& fields) {
     const std::string type = fields.string("type");
     const ShapeEntry* entry = find_entry(type);
     if (entry == nullptr) {
-        fields.fail("type",
-                    "unknown shape type " + quote_name(type) + "; expected one of: " + known_types());
+        fields.fail("type", "unknown shape type " + quote_name(type) +
+                                "; expected one of: " + known_types());
     }
     fields.set_what("a " + type);
     ShapePointer built;
@@ -1103,7 +1105,8 @@ Scene Loader::load() {
                 }
                 known += (known.empty() ? "" : ", ") + shown(known_name);
             }
-            fields.fail("material", "no material named " + quote_name(name) + "; defined: " + known);
+            fields.fail("material",
+                        "no material named " + quote_name(name) + "; defined: " + known);
         }
         return found->second;
     };
@@ -1181,8 +1184,8 @@ public:
                          "duplicate key " + quote_name(key) + " (JSON keeps only one of them)");
         }
         // The key is new: appended without ordered_map's linear search.
-        auto& members = static_cast<Json::object_t::Container&>(
-            *frame.value->get_ptr<Json::object_t*>());
+        auto& members =
+            static_cast<Json::object_t::Container&>(*frame.value->get_ptr<Json::object_t*>());
         members.emplace_back(key, nullptr);
         frame.key = std::move(key);
         return true;
@@ -1291,12 +1294,12 @@ Scene load_scene(const std::filesystem::path& path) {
         throw SceneError(path.string() + ": cannot open the scene file (no such file)");
     }
     if (!std::filesystem::is_regular_file(status)) {
-        const char* kind = std::filesystem::is_directory(status) ? "a directory"
-                           : std::filesystem::is_fifo(status)    ? "a FIFO"
-                           : std::filesystem::is_character_file(status) ||
-                                   std::filesystem::is_block_file(status)
-                               ? "a device"
-                               : "a special file";
+        const char* kind =
+            std::filesystem::is_directory(status) ? "a directory"
+            : std::filesystem::is_fifo(status)    ? "a FIFO"
+            : std::filesystem::is_character_file(status) || std::filesystem::is_block_file(status)
+                ? "a device"
+                : "a special file";
         throw SceneError(path.string() + ": is " + kind + ", not a regular file");
     }
     const std::uintmax_t size = std::filesystem::file_size(path, error);

@@ -12,12 +12,12 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
-#include <new>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <mutex>
+#include <new>
 #include <optional>
-#include <limits>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -279,8 +279,8 @@ void info_command(const std::string& scene_path, CommandLineStreams streams) {
     std::ostream& out = streams.out;
     out << "scene:      " << scene_path << '\n';
     out << "objects:    " << scene.objects().size() << " top-level (" << unbounded
-        << " unbounded), " << counts.shapes << " shapes in the trees under them ("
-        << counts.leaves << " leaves):\n";
+        << " unbounded), " << counts.shapes << " shapes in the trees under them (" << counts.leaves
+        << " leaves):\n";
     for (const auto& [kind, count] : counts.by_kind) {
         char row[96];
         std::snprintf(row, sizeof(row), "  %-18s %llu", kind.c_str(),

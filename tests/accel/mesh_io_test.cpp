@@ -2,15 +2,15 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/Geometry>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <fstream>
 #include <iterator>
-#include <sstream>
 #include <set>
+#include <sstream>
 
 #include "csgrt/accel/mesh_tools.h"
 #include "csgrt/core/error.h"

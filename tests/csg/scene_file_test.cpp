@@ -522,8 +522,8 @@ TEST(SceneFile, ManyMaterialsDefinitionsAndObjectsLoadInOrder) {
 }
 
 TEST(SceneFile, FifosDevicesDirectoriesAndNulBytesAreRefusedAtOnce) {
-    const fs::path folder = fs::temp_directory_path() / ("csgrt_scene_paths_" +
-                                                          std::to_string(::getpid()));
+    const fs::path folder =
+        fs::temp_directory_path() / ("csgrt_scene_paths_" + std::to_string(::getpid()));
     fs::create_directories(folder);
     const fs::path fifo = folder / "pipe.json";
     ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);

@@ -223,8 +223,7 @@ TEST_F(CommandLine, AnOutputThatIsTheSceneIsRefusedInEverySpelling) {
     // A scene named .exr (valid JSON): rendering onto it would replace the scene.
     const fs::path scene = directory_ / "scene.exr";
     std::ofstream(scene) << kSceneText;
-    const fs::path other_spelling =
-        directory_ / ".." / directory_.filename() / "." / "scene.exr";
+    const fs::path other_spelling = directory_ / ".." / directory_.filename() / "." / "scene.exr";
     fs::create_symlink(scene, directory_ / "link.exr");
     for (const fs::path& output : {scene, other_spelling, directory_ / "link.exr"}) {
         const ProgramRun result = run({"render", scene.string(), "-o", output.string()});
@@ -246,8 +245,7 @@ TEST_F(CommandLine, AnUnwritableOutputFolderIsRefusedBeforeRendering) {
         fs::permissions(folder, fs::perms::owner_all);
         GTEST_SKIP() << "running as root: every folder is writable";
     }
-    const ProgramRun result =
-        run({"render", scene_, "-o", (folder / "out.exr").string()});
+    const ProgramRun result = run({"render", scene_, "-o", (folder / "out.exr").string()});
     fs::permissions(folder, fs::perms::owner_all);
     expect_one_line_error(result, "' is not writable: Permission denied");
 }
@@ -260,8 +258,9 @@ TEST_F(CommandLine, AnImageLargerThanMemoryIsRefusedWithTheEstimate) {
     CommandLineStreams streams{out, err};
     streams.memory_bytes = 1u << 20;
     EXPECT_EQ(run_csgrt(5, argv, streams), 1);
-    EXPECT_NE(err.str().find("a 640x480 image needs about 17 MiB, more than the 1 MiB of memory free"),
-              std::string::npos)
+    EXPECT_NE(
+        err.str().find("a 640x480 image needs about 17 MiB, more than the 1 MiB of memory free"),
+        std::string::npos)
         << err.str();
     expect_no_output();
 }
@@ -313,8 +312,9 @@ TEST_F(CommandLine, InfoCountsAnExpansionOfAMillionLeavesWithoutWalkingIt) {
         << text << R"(}, "objects": [{"type": "ref", "definition": "d20"}]})";
     const ProgramRun result = run({"info", scene_});
     ASSERT_EQ(result.status, 0) << result.err;
-    for (const char* fragment : {"2097151 shapes in the trees under them (1048576 leaves)",
-                                 "  compound           1048575\n", "  sphere             1048576\n"}) {
+    for (const char* fragment :
+         {"2097151 shapes in the trees under them (1048576 leaves)",
+          "  compound           1048575\n", "  sphere             1048576\n"}) {
         EXPECT_NE(result.out.find(fragment), std::string::npos) << fragment << "\n" << result.out;
     }
 }
