@@ -63,14 +63,38 @@ std::string shown(std::string_view token) {
     return "'" + text + (token.size() > kLongest ? "...'" : "'");
 }
 
-/// A text file read line by line, each line split at whitespace.
+/// The longest line a text mesh may have: a file of 2 GB without a newline must not be read
+/// into one string. OpenMesh's readers hold a line at a time too.
+constexpr std::size_t kLongestLine = 1u << 20;
+
+/// Reads one line (without its '\n') into `line`, at most kLongestLine bytes; false at the
+/// end of the file. `number` is the line's number, for the message.
+bool read_line(std::istream& in, std::string& line, std::size_t number) {
+    line.clear();
+    std::streambuf& buffer = *in.rdbuf();
+    bool read_any = false;
+    for (int c = buffer.sbumpc(); c != std::char_traits<char>::eof(); c = buffer.sbumpc()) {
+        read_any = true;
+        if (c == '\n') return true;
+        if (line.size() == kLongestLine) {
+            problem_at_line(number, "longer than " + std::to_string(kLongestLine) +
+                                        " bytes (1 MiB), the most a line may have");
+        }
+        line.push_back(static_cast<char>(c));
+    }
+    in.setstate(std::ios::eofbit);
+    return read_any;
+}
+
+/// A text file read line by line, each line split at whitespace; it streams, holding one
+/// line of at most kLongestLine bytes.
 class LineReader {
 public:
     explicit LineReader(std::istream& in) : in_(in) {}
 
     /// Reads the next line; false at the end of the file.
     bool next() {
-        if (!std::getline(in_, line_)) return false;
+        if (!read_line(in_, line_, number_ + 1)) return false;
         ++number_;
         tokens_.clear();
         std::size_t i = 0;
@@ -525,6 +549,13 @@ struct PlyHeader {
     std::size_t lines = 0;
 };
 
+/// A PLY version number ("1.0", "1").
+bool parse_version(std::string_view token, double& value) {
+    const char* end = token.data() + token.size();
+    const auto [stop, error] = std::from_chars(token.data(), end, value);
+    return error == std::errc() && stop == end;
+}
+
 /// Parses the header (up to end_header) and checks that it describes a mesh OpenMesh reads:
 /// a vertex element with float or double x, y, z, then a face element with an integer list
 /// vertex_indices (or vertex_index); other elements only after the faces.
@@ -534,7 +565,8 @@ PlyHeader parse_ply_header(std::istream& in) {
     bool has_format = false;
     constexpr std::size_t kLongestHeader = 4096;  // lines
     while (true) {
-        if (!std::getline(in, line)) problem("truncated: the header has no end_header line");
+        if (!read_line(in, line, header.lines + 1))
+            problem("truncated: the header has no end_header line");
         ++header.lines;
         if (header.lines > kLongestHeader) problem("no end_header in the first 4096 lines");
         if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -552,7 +584,9 @@ PlyHeader parse_ply_header(std::istream& in) {
         if (keyword == "end_header") break;
         if (keyword == "comment" || keyword == "obj_info") continue;
         if (keyword == "format") {
-            if (tokens.size() != 3 || tokens[2] != "1.0")
+            // OpenMesh and assimp read "1", "1.0" and "1.00" alike: the number is what counts.
+            double version = 0.0;
+            if (tokens.size() != 3 || !parse_version(tokens[2], version) || version != 1.0)
                 problem_at_line(number, "expected 'format <type> 1.0'");
             if (tokens[1] == "ascii") {
                 header.format = PlyFormat::kAscii;
@@ -837,7 +871,18 @@ void scan_stl_ascii(std::istream& in, Expectation& expect) {
         if (!lines.next_nonblank())
             problem("truncated: no 'endsolid' after facet " + std::to_string(facet));
         const std::string_view keyword = lines.tokens()[0];
-        if (keyword == "endsolid") break;
+        if (keyword == "endsolid") {
+            // Several solids one after the other (what exporters write for several parts) are
+            // one mesh, as OpenMesh and assimp read them.
+            if (!lines.next_nonblank()) break;
+            if (lines.tokens()[0] != "solid") {
+                problem_at_line(lines.number(),
+                                "expected 'solid' or the end of the file after "
+                                "'endsolid', found " +
+                                    shown(lines.tokens()[0]));
+            }
+            continue;
+        }
         if (keyword != "facet")
             problem_at_line(lines.number(),
                             "expected 'facet' or 'endsolid', found " + shown(keyword));
@@ -856,9 +901,6 @@ void scan_stl_ascii(std::istream& in, Expectation& expect) {
         expect_line("endfacet", "'endfacet'");
         expect_facet(expect, corners);
         ++facet;
-    }
-    if (lines.next_nonblank()) {
-        problem_at_line(lines.number(), "data after 'endsolid' (one solid per file is supported)");
     }
     if (facet == 0) problem("no facets");
 }
@@ -1324,6 +1366,10 @@ MeshReport validate_mesh(TriangleMeshData& mesh) {
 }
 
 namespace {
+/// Meshes are indexed by 32 bits and hold at most 2^30 triangles; a binary STL of 2^30
+/// facets is 50 GiB, but no mesh the library can hold needs a text file beyond 4 GiB.
+constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t{4} << 30;
+
 [[noreturn]] void fail_file(const std::string& name, const std::string& what) {
     throw MeshError(name + ": " + what);
 }
@@ -1332,10 +1378,20 @@ namespace {
 TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report_out) {
     const std::string name = path.string();
     auto fail = [&](const std::string& what) { fail_file(name, what); };
+    if (name.find('\0') != std::string::npos) {
+        fail_file(shown(name), "the path contains a NUL byte, which no file name can");
+    }
     std::error_code error;
     const auto status = std::filesystem::status(path, error);
     if (!std::filesystem::exists(status)) fail("no such file");
-    if (!std::filesystem::is_regular_file(status)) fail("not a regular file");
+    if (!std::filesystem::is_regular_file(status)) {
+        // Refused before opening: a FIFO would block and a device never end.
+        fail(std::filesystem::is_directory(status) ? "a directory, not a regular file"
+             : std::filesystem::is_fifo(status)    ? "a FIFO, not a regular file"
+             : std::filesystem::is_character_file(status) || std::filesystem::is_block_file(status)
+                 ? "a device, not a regular file"
+                 : "not a regular file");
+    }
     const std::uintmax_t size = std::filesystem::file_size(path, error);
     if (error) fail("cannot read its size: " + error.message());
     std::string extension = path.extension().string();
@@ -1345,6 +1401,10 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
         fail("unsupported extension " + shown(extension) + " (expected .off, .obj, .ply or .stl)");
     }
     if (size == 0) fail("empty file");
+    if (size > kMaxMeshFileBytes) {
+        fail("the file has " + std::to_string(size) + " bytes; mesh files are at most " +
+             std::to_string(kMaxMeshFileBytes) + " (4 GiB; docs/meshes.md)");
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) fail("cannot open it for reading");
 

@@ -1,11 +1,14 @@
 #include "csgrt/csg/scene_file.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <set>
 #include <sstream>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "csgrt/accel/mesh.h"
@@ -26,9 +29,56 @@ using ShapePointer = std::shared_ptr<const Shape>;
 /// At most this many copies from one grid: a typo in a count must not exhaust memory.
 constexpr std::size_t kMaxGridCopies = 1'000'000;
 
+/// The limits docs/scene-format.md ("Limits") documents. Nesting: JSON arrays and objects, and
+/// shapes inside shapes (booleans, compounds, grids, refs), so that a hostile file gives an
+/// error instead of overflowing the stack in the loader or, later, in the queries.
+constexpr std::size_t kMaxJsonDepth = 1000;
+constexpr std::size_t kMaxShapeDepth = 256;
+/// Leaf shapes in the expanded scene (every grid copy and every use of a definition counted):
+/// shared definitions and nested grids describe 2^64 leaves in 5 KB, and a ray may have to
+/// visit every one of them.
+constexpr std::uint64_t kMaxExpandedLeaves = 10'000'000;
+/// The file is parsed into memory whole; its tree takes about ten times its size.
+constexpr std::uintmax_t kMaxSceneFileBytes = 256u << 20;
+/// Keys and names longer than this are cut in messages.
+constexpr std::size_t kLongestShownName = 64;
+/// Lights, positions and distances: their squares must stay finite in the shading.
+constexpr double kMaxLength = 1e150;
+/// Light intensities and radiances: far below float's 3.4e38, where the image's pixels live.
+constexpr double kMaxIntensity = 1e30;
+
+/// A name from the file for a message: control characters escaped, cut after
+/// kLongestShownName bytes.
+std::string shown(std::string_view name) {
+    std::string text;
+    const std::string_view kept = name.substr(0, kLongestShownName);
+    for (const char c : kept) {
+        const auto byte = static_cast<unsigned char>(c);
+        if (byte < 0x20 || byte == 0x7f) {
+            char escaped[8];
+            std::snprintf(escaped, sizeof escaped, "\\u%04x", byte);
+            text += escaped;
+        } else {
+            text += c;
+        }
+    }
+    if (name.size() > kept.size()) {
+        text += "... (" + std::to_string(name.size()) + " bytes)";
+    }
+    return text;
+}
+
+/// `shown`, in double quotes.
+std::string quote_name(std::string_view name) {
+    // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "\"" + string + "\"".
+    std::string text = "\"";
+    text.append(shown(name)).append("\"");
+    return text;
+}
+
 std::string escape_pointer_token(std::string_view token) {
     std::string escaped;
-    for (const char c : token) {
+    for (const char c : shown(token)) {
         if (c == '~') {
             escaped += "~0";
         } else if (c == '/') {
@@ -56,7 +106,7 @@ std::string describe(const Json& value) {
         case Json::value_t::boolean:
             return value.get<bool>() ? "true" : "false";
         case Json::value_t::string:
-            return "the string " + value.dump();
+            return "the string " + quote_name(value.get_ref<const std::string&>());
         case Json::value_t::array:
             return "an array of " + std::to_string(value.size());
         case Json::value_t::object:
@@ -66,14 +116,35 @@ std::string describe(const Json& value) {
     }
 }
 
+/// A pointer for a message: a very deep one (the nesting limits are met 500 levels down)
+/// keeps its first and last 120 characters around the count of the levels left out.
+std::string shown_pointer(const std::string& pointer) {
+    if (pointer.empty()) return "(top level)";
+    constexpr std::size_t kKept = 120;
+    if (pointer.size() <= 3 * kKept) return pointer;
+    const std::size_t head = pointer.find('/', kKept);
+    const std::size_t tail = pointer.rfind('/', pointer.size() - kKept);
+    if (head == std::string::npos || tail == std::string::npos || tail <= head) return pointer;
+    const auto levels = std::count(pointer.begin() + static_cast<std::ptrdiff_t>(head),
+                                   pointer.begin() + static_cast<std::ptrdiff_t>(tail), '/');
+    std::string text = pointer.substr(0, head);
+    text.append("/...(").append(std::to_string(levels)).append(" levels)...");
+    text.append(pointer.substr(tail));
+    return text;
+}
+
 /// Where in which file: everything a message needs besides what went wrong.
 struct Source {
     std::string name;
     std::filesystem::path directory;
 
     [[noreturn]] void fail(const std::string& pointer, const std::string& message) const {
-        throw SceneError(name + ": " + (pointer.empty() ? std::string("(top level)") : pointer) +
-                         ": " + message);
+        std::string text = message;
+        // Whatever of the file's text got into the message stays on one line.
+        for (char& c : text) {
+            if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+        }
+        throw SceneError(name + ": " + shown_pointer(pointer) + ": " + text);
     }
 };
 
@@ -174,7 +245,7 @@ public:
     void finish() const {
         for (auto it = value_.begin(); it != value_.end(); ++it) {
             if (std::find(asked_.begin(), asked_.end(), it.key()) != asked_.end()) continue;
-            std::string message = "unknown key \"" + it.key() + "\" in " + what_;
+            std::string message = "unknown key " + quote_name(it.key()) + " in " + what_;
             if (it.key() == "material" || it.key() == "name") {
                 message += " (\"" + it.key() + "\" belongs to the top-level objects)";
             } else if (it.key() == "materials") {
@@ -283,10 +354,21 @@ private:
     void materials(Scene& scene, std::map<std::string, std::uint32_t>& by_name);
     void lights(Scene& scene);
 
+    /// Counts `shape`'s expanded leaves into the scene's total and fails at `pointer` once the
+    /// total passes kMaxExpandedLeaves.
+    void count_leaves(const Shape& shape, const std::string& pointer);
+
     const Json& root_;
     const Source& source_;
     const Json* definitions_ = nullptr;
+    /// The definitions by name, so a ref costs a hash look-up, not a scan of the object.
+    std::unordered_map<std::string, const Json*> definition_index_;
     std::map<std::string, ShapePointer> built_;
+    /// Shapes being built, one per nesting level (refs included), against kMaxShapeDepth.
+    std::size_t depth_ = 0;
+    /// Each distinct shape's count of expanded leaves, so shared subtrees are counted once.
+    std::unordered_map<const Shape*, std::uint64_t> leaves_;
+    std::uint64_t total_leaves_ = 0;
     std::map<std::string, ShapePointer> meshes_;
     /// Definitions being built, outermost first: a name met again here is a cycle.
     std::vector<std::string> building_;
@@ -511,37 +593,134 @@ std::string known_types() {
     return known;
 }
 
+/// The parameter an InvalidParameter names: "What: parameter must be ...".
+std::string parameter_of(const InvalidParameter& error) {
+    const std::string_view message = error.what();
+    const auto colon = message.find(": ");
+    const auto must = message.find(" must be ");
+    if (colon == std::string_view::npos || must == std::string_view::npos || must < colon)
+        return {};
+    return std::string(message.substr(colon + 2, must - colon - 2));
+}
+
 /// Turns a shape's InvalidParameter ("Sphere: radius must be > 0 ...") into a SceneError at the
 /// key the message names, when the node has that key, else at the node.
 [[noreturn]] void rethrow_invalid(const InvalidParameter& error, const Fields& fields,
                                   const Json& node, bool angles) {
     std::string message = error.what();
     std::string pointer = fields.pointer();
-    const auto colon = message.find(": ");
-    const auto must = message.find(" must be ");
-    if (colon != std::string::npos && must != std::string::npos && must > colon) {
-        std::string parameter = message.substr(colon + 2, must - colon - 2);
-        // The structure name of a compound or grid is its "accelerator" key; the keys every
-        // node may have are never a shape's parameter.
-        if (message.starts_with("make_accelerator: name")) parameter = "accelerator";
-        const bool shape_key = parameter != "name" && parameter != "material" &&
-                               parameter != "type" && parameter != "transform";
-        if (shape_key && node.is_object() && node.contains(parameter)) {
-            pointer = fields.pointer(parameter);
-        }
-        if (angles && (parameter.starts_with("phi") || parameter.starts_with("theta"))) {
-            message += " (radians: the file's degrees times pi / 180)";
-        }
+    std::string parameter = parameter_of(error);
+    // The structure name of a compound or grid is its "accelerator" key; the keys every node
+    // may have are never a shape's parameter.
+    if (message.starts_with("make_accelerator:") && parameter == "name") parameter = "accelerator";
+    const bool shape_key = !parameter.empty() && parameter != "name" && parameter != "material" &&
+                           parameter != "type" && parameter != "transform";
+    if (shape_key && node.is_object() && node.contains(parameter)) {
+        pointer = fields.pointer(parameter);
+    }
+    if (angles && (parameter.starts_with("phi") || parameter.starts_with("theta"))) {
+        message += " (radians: the file's degrees times pi / 180)";
     }
     fields.source().fail(pointer, message);
 }
 
+/// The shapes `shape` is made of: an instance's shape, a boolean's operands, a compound's
+/// children; none for a leaf.
+std::vector<const Shape*> children_of(const Shape& shape) {
+    if (const auto* instance = dynamic_cast<const Instance*>(&shape)) return {&instance->shape()};
+    if (const auto* node = dynamic_cast<const Boolean*>(&shape)) {
+        return {&node->first(), &node->second()};
+    }
+    std::vector<const Shape*> children;
+    if (const auto* compound = dynamic_cast<const Compound*>(&shape)) {
+        for (const auto& child : compound->children()) children.push_back(child.get());
+    }
+    return children;
+}
+
+/// `value` plus `add`, saturating at the largest count rather than wrapping.
+std::uint64_t saturating_add(std::uint64_t value, std::uint64_t add) {
+    return add > std::numeric_limits<std::uint64_t>::max() - value
+               ? std::numeric_limits<std::uint64_t>::max()
+               : value + add;
+}
+
+/// The leaves of the tree under `shape` with every shared subtree counted once per use,
+/// memoised per distinct shape: linear in the distinct shapes, whatever the expansion.
+std::uint64_t expanded_leaves(const Shape& shape,
+                              std::unordered_map<const Shape*, std::uint64_t>& memo) {
+    if (const auto found = memo.find(&shape); found != memo.end()) return found->second;
+    const std::vector<const Shape*> children = children_of(shape);
+    std::uint64_t leaves = children.empty() ? 1 : 0;
+    for (const Shape* child : children)
+        leaves = saturating_add(leaves, expanded_leaves(*child, memo));
+    memo.emplace(&shape, leaves);
+    return leaves;
+}
+
+void Loader::count_leaves(const Shape& shape, const std::string& pointer) {
+    total_leaves_ = saturating_add(total_leaves_, expanded_leaves(shape, leaves_));
+    if (total_leaves_ > kMaxExpandedLeaves) {
+        const std::string count = total_leaves_ == std::numeric_limits<std::uint64_t>::max()
+                                      ? "at least 2^64 - 1"
+                                      : std::to_string(total_leaves_);
+        source_.fail(pointer, "the scene expands to " + count +
+                                  " leaf shapes up to here (every grid copy and every use of a "
+                                  "definition counts); at most " +
+                                  std::to_string(kMaxExpandedLeaves) +
+                                  " are allowed (docs/scene-format.md, Limits)");
+    }
+}
+
+/// Fails at `at` unless `transform` and its inverse are finite: a product of finite steps can
+/// overflow (scale 1e200 twice) or underflow, whose inverse then overflows (scale 1e-320).
+void require_representable(const Transform& transform, const Source& source, const std::string& at,
+                           bool product) {
+    const bool forward = transform.linear().allFinite() && transform.translation().allFinite();
+    const bool backward =
+        transform.inverse_linear().allFinite() && transform.inverse().translation().allFinite();
+    if (forward && backward) return;
+    const std::string what =
+        product ? "the product of the transforms up to this one" : "this transform";
+    source.fail(at, what + (forward ? " underflows: its inverse" : " overflows: it") +
+                        " has a coefficient beyond the largest double (1.8e308)");
+}
+
+/// Fails at `key` of `fields` unless |v|^2 is finite (and, for a direction, not zero when v
+/// is not): the shading and the camera square lengths and normalise.
+void require_length(const Vector3& v, Fields& fields, std::string_view key, std::string_view what,
+                    bool direction) {
+    // stableNorm scales first, so the length it reports is the true one, not an overflow.
+    const double length = v.stableNorm();
+    if (!(length <= kMaxLength)) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.6g", length);
+        fields.fail(key, std::string(what) + " has length " + text +
+                             ", beyond 1e150: its square overflows a double in the shading");
+    }
+    if (direction && v.squaredNorm() < DBL_MIN) {
+        fields.fail(key, std::string(what) + " " + detail::describe(v) +
+                             " is too short: its square underflows a double, so it has no "
+                             "direction");
+    }
+}
+
 ShapePointer Loader::shape(Fields& fields) {
+    if (depth_ >= kMaxShapeDepth) {
+        fields.fail("", "shapes nested deeper than " + std::to_string(kMaxShapeDepth) +
+                            " levels (booleans, compounds, grids and refs each count; "
+                            "docs/scene-format.md, Limits)");
+    }
+    struct Level {
+        std::size_t& depth;
+        explicit Level(std::size_t& d) : depth(++d) {}
+        ~Level() { --depth; }
+    } level(depth_);
     const std::string type = fields.string("type");
     const ShapeEntry* entry = find_entry(type);
     if (entry == nullptr) {
-        fields.fail("type",
-                    "unknown shape type \"" + type + "\"; expected one of: " + known_types());
+        fields.fail("type", "unknown shape type " + quote_name(type) +
+                                "; expected one of: " + known_types());
     }
     fields.set_what("a " + type);
     ShapePointer built;
@@ -551,8 +730,14 @@ ShapePointer Loader::shape(Fields& fields) {
         rethrow_invalid(error, fields, fields.value(), entry->angles);
     }
     if (fields.has("transform")) {
+        const bool bounded = built->bounds().is_finite();
         built = place(std::move(built), transform(fields.array("transform", 0, "transforms"),
                                                   fields.pointer("transform")));
+        if (bounded && !built->bounds().is_finite()) {
+            fields.fail("transform",
+                        "the transformed shape's bounds overflow a double (1.8e308); the shape "
+                        "would vanish");
+        }
     }
     return built;
 }
@@ -605,6 +790,14 @@ std::vector<ShapePointer> Loader::grid(Fields& fields) {
     const Vector3 spacing = fields.vector("spacing");
     const ShapePointer item =
         shape(fields.required("item", "a shape node"), fields.pointer("item"), "a grid item");
+    // Refused before the copies are made: a grid of grids is a product.
+    const std::uint64_t item_leaves = expanded_leaves(*item, leaves_);
+    if (item_leaves > kMaxExpandedLeaves / total) {
+        fields.fail("count", std::to_string(total) + " copies of an item of " +
+                                 std::to_string(item_leaves) + " leaf shapes are more than the " +
+                                 std::to_string(kMaxExpandedLeaves) +
+                                 " leaves a scene may expand to (docs/scene-format.md, Limits)");
+    }
     Transform placement;
     if (fields.has("transform")) {
         placement =
@@ -632,14 +825,20 @@ std::vector<ShapePointer> Loader::grid(Fields& fields) {
 
 ShapePointer Loader::definition(const std::string& name, const std::string& pointer) {
     if (const auto found = built_.find(name); found != built_.end()) return found->second;
-    if (definitions_ == nullptr || !definitions_->contains(name)) {
+    const auto indexed = definition_index_.find(name);
+    if (indexed == definition_index_.end()) {
         std::string known;
+        std::size_t listed = 0;
         if (definitions_ != nullptr) {
             for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
-                known += (known.empty() ? "" : ", ") + it.key();
+                if (++listed > 20) {
+                    known += ", ...";
+                    break;
+                }
+                known += (known.empty() ? "" : ", ") + shown(it.key());
             }
         }
-        source_.fail(pointer, "no definition named \"" + name + "\"" +
+        source_.fail(pointer, "no definition named " + quote_name(name) +
                                   (known.empty() ? " (the file has no \"definitions\")"
                                                  : "; defined: " + known));
     }
@@ -652,8 +851,8 @@ ShapePointer Loader::definition(const std::string& name, const std::string& poin
         source_.fail(pointer, "reference cycle: " + cycle + name);
     }
     building_.push_back(name);
-    ShapePointer built = shape(definitions_->at(name), child_pointer("/definitions", name),
-                               "the definition \"" + name + "\"");
+    ShapePointer built = shape(*indexed->second, child_pointer("/definitions", name),
+                               "the definition " + quote_name(name));
     building_.pop_back();
     built_[name] = built;
     return built;
@@ -661,6 +860,10 @@ ShapePointer Loader::definition(const std::string& name, const std::string& poin
 
 ShapePointer Loader::mesh(Fields& fields) {
     const std::string path = fields.string("path");
+    if (path.find('\0') != std::string::npos) {
+        fields.fail("path", "the path contains a NUL byte (\\u0000), which no file name can");
+    }
+    if (path.empty()) fields.fail("path", "expected a file name, got an empty string");
     MeshConfig config;
     config.double_precision = fields.boolean("double_precision", false);
     config.accelerator = fields.string("accelerator", config.accelerator);
@@ -717,7 +920,7 @@ Transform Loader::transform(const Json& list, const std::string& pointer) const 
                     if (name == "x") return 0;
                     if (name == "y") return 1;
                     if (name == "z") return 2;
-                    shear.fail(key, "expected \"x\", \"y\" or \"z\", got \"" + name + "\"");
+                    shear.fail(key, "expected \"x\", \"y\" or \"z\", got " + quote_name(name));
                 };
                 const int axis = axis_of("axis");
                 const int by = axis_of("by");
@@ -750,7 +953,9 @@ Transform Loader::transform(const Json& list, const std::string& pointer) const 
         } catch (const InvalidParameter& error) {
             source_.fail(value_at, error.what());
         }
+        require_representable(step, source_, value_at, false);
         world_from_object = step * world_from_object;
+        require_representable(world_from_object, source_, value_at, true);
     }
     return world_from_object;
 }
@@ -764,7 +969,7 @@ void Loader::camera(Scene& scene) {
             camera.projection = Camera::Projection::Orthographic;
         } else if (projection != "pinhole") {
             fields.fail("projection",
-                        "expected \"pinhole\" or \"orthographic\", got \"" + projection + "\"");
+                        "expected \"pinhole\" or \"orthographic\", got " + quote_name(projection));
         }
         camera.position = fields.vector("position", camera.position);
         camera.look_at = fields.vector("look_at", camera.look_at);
@@ -774,6 +979,14 @@ void Loader::camera(Scene& scene) {
         camera.orthographic_height =
             fields.number("orthographic_height", camera.orthographic_height);
         fields.finish();
+        require_length(camera.position, fields, "position", "the position", false);
+        require_length(camera.look_at, fields, "look_at", "look_at", false);
+        require_length(camera.up, fields, "up", "the up vector", true);
+        // look_at == position is Camera::validate's to report.
+        if (camera.look_at != camera.position) {
+            require_length(camera.look_at - camera.position, fields, "look_at",
+                           "the view direction look_at - position", true);
+        }
         try {
             camera.validate();
         } catch (const InvalidParameter& error) {
@@ -840,11 +1053,17 @@ void Loader::lights(Scene& scene) {
             if (!(colour.array() >= 0.0).all()) {
                 fields.fail(key, "expected values >= 0, got " + detail::describe(colour));
             }
+            if (!(colour.array() <= kMaxIntensity).all()) {
+                fields.fail(key, "expected values <= " + detail::describe(kMaxIntensity) +
+                                     " (brighter overflows the image's float pixels), got " +
+                                     detail::describe(colour));
+            }
         };
         if (type == "point") {
             fields.set_what("a point light");
             PointLight light;
             light.position = fields.vector("position");
+            require_length(light.position, fields, "position", "the position", false);
             light.intensity = fields.colour("intensity", light.intensity);
             check_colour("intensity", light.intensity);
             light.falloff = fields.number("falloff", light.falloff);
@@ -857,14 +1076,15 @@ void Loader::lights(Scene& scene) {
             fields.set_what("a directional light");
             DirectionalLight light;
             light.direction = fields.vector("direction");
-            if (light.direction.squaredNorm() == 0.0) {
+            if ((light.direction.array() == 0.0).all()) {
                 fields.fail("direction", "expected a non-zero direction, got (0, 0, 0)");
             }
+            require_length(light.direction, fields, "direction", "the direction", true);
             light.radiance = fields.colour("radiance", light.radiance);
             check_colour("radiance", light.radiance);
             scene.add_light(light);
         } else {
-            fields.fail("type", "expected \"point\" or \"directional\", got \"" + type + "\"");
+            fields.fail("type", "expected \"point\" or \"directional\", got " + quote_name(type));
         }
         fields.finish();
     }
@@ -887,6 +1107,9 @@ Scene Loader::load() {
             source_.fail("/definitions",
                          "expected an object of named shapes, got " + describe(*definitions_));
         }
+        for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
+            definition_index_.emplace(it.key(), &it.value());
+        }
         // Every definition is built, used or not, so its errors are reported.
         for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
             definition(it.key(), child_pointer("/definitions", it.key()));
@@ -898,10 +1121,16 @@ Scene Loader::load() {
         const auto found = material_index.find(name);
         if (found == material_index.end()) {
             std::string known;
+            std::size_t listed = 0;
             for (const auto& [known_name, index] : material_index) {
-                known += (known.empty() ? "" : ", ") + known_name;
+                if (++listed > 20) {
+                    known += ", ...";
+                    break;
+                }
+                known += (known.empty() ? "" : ", ") + shown(known_name);
             }
-            fields.fail("material", "no material named \"" + name + "\"; defined: " + known);
+            fields.fail("material",
+                        "no material named " + quote_name(name) + "; defined: " + known);
         }
         return found->second;
     };
@@ -930,6 +1159,7 @@ Scene Loader::load() {
             fields.set_what("a grid");
             const auto copies = grid(fields);
             fields.finish();
+            for (const ShapePointer& copy : copies) count_leaves(*copy, fields.pointer());
             for (std::size_t c = 0; c < copies.size(); ++c) {
                 scene.add_object(copies[c], palette[c % palette.size()],
                                  name.empty() ? name : name + "[" + std::to_string(c) + "]");
@@ -937,69 +1167,113 @@ Scene Loader::load() {
         } else {
             ShapePointer built = shape(fields);
             fields.finish();
+            count_leaves(*built, fields.pointer());
             scene.add_object(std::move(built), palette.front(), name);
         }
     }
     return scene;
 }
 
-/// Rejects duplicate keys while parsing (nlohmann keeps the last one silently), naming the
-/// object they are in by its JSON pointer.
-class DuplicateKeyCheck {
+/// Builds the JSON tree from the parser's events, rejecting duplicate keys (nlohmann keeps the
+/// last one silently) and nesting deeper than kMaxJsonDepth, each at its JSON pointer.
+///
+/// It replaces nlohmann's callback parser, which after every closed child scans its parent
+/// for a discarded element (quadratic in the length of "objects"), and ordered_json's
+/// `operator[]`, which finds a key by a linear search (quadratic in the number of materials
+/// or definitions): a key is checked once against a hash set and appended. The pointer of the
+/// current place is only assembled for a message.
+class SceneTreeBuilder {
 public:
-    explicit DuplicateKeyCheck(const Source& source) : source_(source) {}
+    using String = Json::string_t;
 
-    bool operator()(int, Json::parse_event_t event, Json& parsed) {
-        using Event = Json::parse_event_t;
-        switch (event) {
-            case Event::object_start:
-            case Event::array_start:
-                enter_element();
-                frames_.push_back(Frame{event == Event::array_start, 0, {}, {}});
-                break;
-            case Event::object_end:
-            case Event::array_end:
-                frames_.pop_back();
-                break;
-            case Event::key: {
-                Frame& frame = frames_.back();
-                const std::string key = parsed.get<std::string>();
-                if (!frame.keys.insert(key).second) {
-                    source_.fail(path() + "/" + escape_pointer_token(key),
-                                 "duplicate key \"" + key + "\" (JSON keeps only one of them)");
-                }
-                frame.key = key;
-                break;
-            }
-            case Event::value:
-                enter_element();
-                break;
+    SceneTreeBuilder(Json& root, const Source& source) : root_(root), source_(source) {}
+
+    bool null() { return place(Json(nullptr)); }
+    bool boolean(bool value) { return place(Json(value)); }
+    bool number_integer(Json::number_integer_t value) { return place(Json(value)); }
+    bool number_unsigned(Json::number_unsigned_t value) { return place(Json(value)); }
+    bool number_float(Json::number_float_t value, const String&) { return place(Json(value)); }
+    bool string(String& value) { return place(Json(std::move(value))); }
+    bool binary(Json::binary_t& value) { return place(Json::binary(std::move(value))); }
+
+    bool start_object(std::size_t) { return open(Json::value_t::object); }
+    bool start_array(std::size_t) { return open(Json::value_t::array); }
+    bool end_object() { return close(); }
+    bool end_array() { return close(); }
+
+    bool key(String& key) {
+        Frame& frame = frames_.back();
+        if (!frame.keys.insert(key).second) {
+            source_.fail(path() + "/" + escape_pointer_token(key),
+                         "duplicate key " + quote_name(key) + " (JSON keeps only one of them)");
         }
+        // The key is new: appended without ordered_map's linear search.
+        auto& members =
+            static_cast<Json::object_t::Container&>(*frame.value->get_ptr<Json::object_t*>());
+        members.emplace_back(key, nullptr);
+        frame.key = std::move(key);
         return true;
+    }
+
+    template <class Exception>
+    bool parse_error(std::size_t, const std::string&, const Exception& error) {
+        throw error;
     }
 
 private:
     struct Frame {
-        bool array;
-        std::size_t next_index;
+        Json* value;
+        std::size_t elements = 0;
         std::string key;
-        std::set<std::string> keys;
+        std::unordered_set<std::string> keys;
     };
 
-    void enter_element() {
-        if (!frames_.empty() && frames_.back().array) ++frames_.back().next_index;
+    /// Where the next value goes: the root, the last key's slot, or the end of an array.
+    Json* slot() {
+        if (frames_.empty()) return &root_;
+        Frame& frame = frames_.back();
+        ++frame.elements;
+        if (frame.value->is_array()) {
+            auto& elements = *frame.value->get_ptr<Json::array_t*>();
+            elements.emplace_back();
+            return &elements.back();
+        }
+        return &frame.value->get_ptr<Json::object_t*>()->back().second;
     }
 
-    /// The pointer of the innermost open object.
+    bool place(Json&& value) {
+        *slot() = std::move(value);
+        return true;
+    }
+
+    bool open(Json::value_t type) {
+        if (frames_.size() >= kMaxJsonDepth) {
+            source_.fail(path(), "nesting deeper than " + std::to_string(kMaxJsonDepth) +
+                                     " arrays and objects (docs/scene-format.md, Limits)");
+        }
+        Json* value = slot();
+        *value = Json(type);
+        frames_.push_back(Frame{value, 0, {}, {}});
+        return true;
+    }
+
+    bool close() {
+        frames_.pop_back();
+        return true;
+    }
+
+    /// The pointer of the value being read.
     std::string path() const {
         std::string pointer;
         for (std::size_t i = 0; i + 1 < frames_.size(); ++i) {
-            pointer += "/" + (frames_[i].array ? std::to_string(frames_[i].next_index - 1)
-                                               : escape_pointer_token(frames_[i].key));
+            pointer += '/';
+            pointer += frames_[i].value->is_array() ? std::to_string(frames_[i].elements - 1)
+                                                    : escape_pointer_token(frames_[i].key);
         }
         return pointer;
     }
 
+    Json& root_;
     const Source& source_;
     std::vector<Frame> frames_;
 };
@@ -1007,7 +1281,8 @@ private:
 Scene load(std::string_view text, const Source& source) {
     Json root;
     try {
-        root = Json::parse(text, DuplicateKeyCheck(source));
+        SceneTreeBuilder builder(root, source);
+        Json::sax_parse(text, &builder);
     } catch (const nlohmann::json::parse_error& error) {
         // what() is "[json.exception.parse_error.101] parse error at line 3, column 5: ...".
         std::string message = error.what();
@@ -1032,6 +1307,32 @@ Scene load(std::string_view text, const Source& source) {
 }  // namespace
 
 Scene load_scene(const std::filesystem::path& path) {
+    const std::string& native = path.native();
+    if (native.find('\0') != std::string::npos) {
+        throw SceneError(shown(native) + ": the path contains a NUL byte");
+    }
+    // Checked before opening: opening a FIFO blocks, and a device never ends.
+    std::error_code error;
+    const auto status = std::filesystem::status(path, error);
+    if (!std::filesystem::exists(status)) {
+        throw SceneError(path.string() + ": cannot open the scene file (no such file)");
+    }
+    if (!std::filesystem::is_regular_file(status)) {
+        const char* kind =
+            std::filesystem::is_directory(status) ? "a directory"
+            : std::filesystem::is_fifo(status)    ? "a FIFO"
+            : std::filesystem::is_character_file(status) || std::filesystem::is_block_file(status)
+                ? "a device"
+                : "a special file";
+        throw SceneError(path.string() + ": is " + kind + ", not a regular file");
+    }
+    const std::uintmax_t size = std::filesystem::file_size(path, error);
+    if (error) throw SceneError(path.string() + ": cannot read its size: " + error.message());
+    if (size > kMaxSceneFileBytes) {
+        throw SceneError(path.string() + ": the file has " + std::to_string(size) +
+                         " bytes; scene files are at most " + std::to_string(kMaxSceneFileBytes) +
+                         " (256 MiB; docs/scene-format.md, Limits)");
+    }
     std::ifstream file(path, std::ios::binary);
     if (!file) throw SceneError(path.string() + ": cannot open the scene file");
     std::ostringstream text;
@@ -1043,6 +1344,61 @@ Scene load_scene(const std::filesystem::path& path) {
 Scene load_scene_from_string(std::string_view text, const std::string& name,
                              const std::filesystem::path& directory) {
     return load(text, Source{name, directory});
+}
+
+namespace {
+
+/// One distinct shape's counts over its expansion.
+struct NodeCounts {
+    std::map<std::string_view, std::uint64_t> kinds;
+    std::uint64_t leaves = 0;
+    std::uint64_t triangles = 0;
+};
+
+void add_counts(NodeCounts& into, const NodeCounts& from) {
+    for (const auto& [kind, count] : from.kinds) {
+        into.kinds[kind] = saturating_add(into.kinds[kind], count);
+    }
+    into.leaves = saturating_add(into.leaves, from.leaves);
+    into.triangles = saturating_add(into.triangles, from.triangles);
+}
+
+/// Memoised for every composite but instances (which the loader folds into one per use, so
+/// there are as many as uses): a leaf costs nothing to count again.
+NodeCounts count_node(const Shape& shape, std::unordered_map<const Shape*, NodeCounts>& memo) {
+    if (const auto found = memo.find(&shape); found != memo.end()) return found->second;
+    NodeCounts counts;
+    counts.kinds[shape.kind()] = 1;
+    const std::vector<const Shape*> children = children_of(shape);
+    if (children.empty()) {
+        counts.leaves = 1;
+        // The one leaf kind with parts of its own.
+        if (const auto* mesh = dynamic_cast<const Mesh*>(&shape)) {
+            counts.triangles = mesh->triangle_count();
+        }
+        return counts;
+    }
+    for (const Shape* child : children) add_counts(counts, count_node(*child, memo));
+    if (shape.kind() != "instance") memo.emplace(&shape, counts);
+    return counts;
+}
+
+}  // namespace
+
+SceneShapeCounts count_scene_shapes(const Scene& scene) {
+    std::unordered_map<const Shape*, NodeCounts> memo;
+    NodeCounts total;
+    for (const SceneObject& object : scene.objects()) {
+        add_counts(total, count_node(*object.shape, memo));
+    }
+    SceneShapeCounts counts;
+    for (const auto& [kind, count] : total.kinds) {
+        counts.by_kind.emplace(std::string(kind), count);
+        counts.shapes = saturating_add(counts.shapes, count);
+    }
+    counts.leaves = total.leaves;
+    counts.triangles = total.triangles;
+    return counts;
 }
 
 std::span<const std::string_view> scene_shape_types() {

@@ -1,14 +1,24 @@
 #include "csgrt/render/command_line.h"
 
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <mutex>
+#include <new>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -75,10 +85,12 @@ void check_scene_path(const fs::path& path) {
     if (fs::is_directory(path, error)) {
         throw UsageError("scene file '" + path.string() + "' is a directory");
     }
+    // FIFOs, devices and sizes: load_scene refuses them with the reason.
 }
 
-/// Fails early, before any work, for an output the writer could not produce.
-void check_output_path(const fs::path& path) {
+/// Fails early, before any work, for an output the writer could not produce or that would
+/// replace the scene it renders.
+void check_output_path(const fs::path& path, const fs::path& scene) {
     if (path.extension() != ".exr") {
         throw UsageError("output '" + path.string() +
                          "' must end in .exr (the PNG previews are written beside it)");
@@ -88,11 +100,41 @@ void check_output_path(const fs::path& path) {
     if (!fs::is_directory(directory, error)) {
         throw UsageError("output directory '" + directory.string() + "' does not exist");
     }
+    if (::access(directory.c_str(), W_OK | X_OK) != 0) {
+        throw UsageError("output directory '" + directory.string() +
+                         "' is not writable: " + std::strerror(errno));
+    }
     for (const fs::path& target : {path, colour_preview_path(path), cost_preview_path(path)}) {
         if (fs::is_directory(target, error)) {
             throw UsageError("output '" + target.string() + "' is a directory");
         }
+        // equivalent() compares device and inode: another spelling, a symlink or a hard link
+        // of the scene is the scene.
+        if (fs::exists(target, error) && fs::equivalent(target, scene, error)) {
+            throw UsageError("output '" + target.string() + "' is the scene file '" +
+                             scene.string() + "'; rendering would overwrite it");
+        }
     }
+}
+
+/// What the image of a render takes: the pixels (every channel), and while writing, the
+/// previews' 8-bit rows and the EXR's half colour.
+std::uint64_t image_bytes(int width, int height) {
+    const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
+    return pixels * (sizeof(Pixel) + 4 + 4 + 8);
+}
+
+std::string in_mebibytes(std::uint64_t bytes) {
+    return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB";
+}
+
+/// The machine's free memory now, or `configured` when set.
+std::uint64_t memory_available(std::uint64_t configured) {
+    if (configured > 0) return configured;
+    const long pages = ::sysconf(_SC_AVPHYS_PAGES);
+    const long page_size = ::sysconf(_SC_PAGESIZE);
+    if (pages <= 0 || page_size <= 0) return std::numeric_limits<std::uint64_t>::max();
+    return std::uint64_t(pages) * std::uint64_t(page_size);
 }
 
 Scene load_checked(const std::string& scene_path) {
@@ -228,7 +270,15 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
     }
     tone_mapping.exposure_stops = options.exposure_stops;
     const fs::path output = options.output;
-    check_output_path(output);
+    check_output_path(output, options.scene);
+    const std::uint64_t needed = image_bytes(options.width, options.height);
+    const std::uint64_t available = memory_available(streams.memory_bytes);
+    if (needed > available) {
+        throw UsageError("a " + std::to_string(options.width) + "x" +
+                         std::to_string(options.height) + " image needs about " +
+                         in_mebibytes(needed) + ", more than the " + in_mebibytes(available) +
+                         " of memory free here; render a smaller image");
+    }
 
     std::array<double, 4> stage_seconds{};  // load, commit, render, write
     Clock::time_point stage_start = Clock::now();
@@ -247,7 +297,15 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
     settings.threads = options.threads;
     ProgressBar bar(streams.err, streams.err_is_terminal, streams.progress_delay_seconds);
     settings.progress = [&bar](double fraction) { bar.update(fraction); };
-    const RenderResult result = render(scene, settings);
+    std::optional<RenderResult> rendered;
+    try {
+        rendered.emplace(render(scene, settings));
+    } catch (const std::bad_alloc&) {
+        bar.finish();
+        throw UsageError("out of memory while rendering (the image alone needs about " +
+                         in_mebibytes(needed) + ")");
+    }
+    const RenderResult& result = *rendered;
     bar.finish();
 
     const AcceleratorStats structure = scene.accelerator_stats();
@@ -261,7 +319,10 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
     metadata.render_seconds = result.stats.seconds;
     metadata.objects = exr_objects(scene);
     stage_start = Clock::now();
-    write_render_files(output, result.image, metadata, tone_mapping);
+    {
+        const TemporariesRemovedOnSignal guard(output);
+        write_render_files(output, result.image, metadata, tone_mapping);
+    }
     stage_seconds[2] = result.stats.seconds;
     stage_seconds[3] = seconds_since(stage_start);
 
@@ -281,35 +342,6 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
     if (options.statistics) print_statistics(streams.out, scene, result.stats, stage_seconds);
 }
 
-/// Counts every shape in the tree under `shape` by kind(), descending through instances,
-/// booleans and compounds; a shape shared by several parents counts once per use. Meshes add
-/// their triangles to `triangles`.
-void count_kinds(const Shape& shape, std::map<std::string, std::size_t>& counts,
-                 std::size_t& triangles) {
-    const std::string_view kind = shape.kind();
-    ++counts[std::string(kind)];
-    if (kind == "mesh") {
-        if (const auto* mesh = dynamic_cast<const Mesh*>(&shape)) {
-            triangles += mesh->triangle_count();
-        }
-    } else if (kind == "instance") {
-        if (const auto* instance = dynamic_cast<const Instance*>(&shape)) {
-            count_kinds(instance->shape(), counts, triangles);
-        }
-    } else if (kind == "union" || kind == "intersection" || kind == "difference") {
-        if (const auto* node = dynamic_cast<const Boolean*>(&shape)) {
-            count_kinds(node->first(), counts, triangles);
-            count_kinds(node->second(), counts, triangles);
-        }
-    } else if (kind == "compound") {
-        if (const auto* compound = dynamic_cast<const Compound*>(&shape)) {
-            for (const auto& child : compound->children()) {
-                count_kinds(*child, counts, triangles);
-            }
-        }
-    }
-}
-
 std::string describe(const Vector3& v) {
     std::ostringstream text;
     text.precision(6);
@@ -320,23 +352,23 @@ std::string describe(const Vector3& v) {
 void info_command(const std::string& scene_path, CommandLineStreams streams) {
     Scene scene = load_checked(scene_path);
     scene.commit();  // "auto": what a render without --accel would build
-    std::map<std::string, std::size_t> counts;
-    std::size_t unbounded = 0, triangles = 0;
+    // Memoised per distinct shape: a 2^64-leaf expansion costs what was loaded, not 2^64.
+    const SceneShapeCounts counts = count_scene_shapes(scene);
+    std::size_t unbounded = 0;
     for (const SceneObject& object : scene.objects()) {
-        count_kinds(*object.shape, counts, triangles);
         if (!object.shape->bounds().is_finite()) ++unbounded;
     }
-    std::size_t shapes = 0;
-    for (const auto& [kind, count] : counts) shapes += count;
     std::ostream& out = streams.out;
     out << "scene:      " << scene_path << '\n';
     out << "objects:    " << scene.objects().size() << " top-level (" << unbounded
-        << " unbounded), " << shapes << " shapes in the trees under them:\n";
-    for (const auto& [kind, count] : counts) {
+        << " unbounded), " << counts.shapes << " shapes in the trees under them (" << counts.leaves
+        << " leaves):\n";
+    for (const auto& [kind, count] : counts.by_kind) {
         char row[96];
-        std::snprintf(row, sizeof(row), "  %-18s %zu", kind.c_str(), count);
+        std::snprintf(row, sizeof(row), "  %-18s %llu", kind.c_str(),
+                      static_cast<unsigned long long>(count));
         out << row;
-        if (kind == "mesh") out << " (" << triangles << " triangles in all)";
+        if (kind == "mesh") out << " (" << counts.triangles << " triangles in all)";
         out << '\n';
     }
     std::size_t point_lights = 0;
@@ -371,6 +403,70 @@ void validate_command(const std::string& scene_path) {
 }
 
 }  // namespace
+
+namespace {
+
+// The handler may only call async-signal-safe functions, so everything it needs is prepared
+// beforehand in these fixed buffers: the folder, opened, and the name prefixes.
+int signal_directory = -1;
+char signal_prefixes[3][512];
+int signal_prefix_count = 0;
+struct sigaction previous_interrupt, previous_terminate;
+
+/// Removes the folder's entries that start with one of the prefixes, then dies of the signal
+/// as it would have without the handler.
+extern "C" void remove_temporaries_and_die(int signal) {
+    if (signal_directory >= 0) {
+        alignas(8) char buffer[4096];
+        ::lseek(signal_directory, 0, SEEK_SET);
+        long bytes;
+        while ((bytes = ::syscall(SYS_getdents64, signal_directory, buffer, sizeof buffer)) > 0) {
+            for (long offset = 0; offset < bytes;) {
+                const auto* entry = reinterpret_cast<const struct dirent64*>(buffer + offset);
+                for (int p = 0; p < signal_prefix_count; ++p) {
+                    if (std::strncmp(entry->d_name, signal_prefixes[p],
+                                     std::strlen(signal_prefixes[p])) == 0) {
+                        ::unlinkat(signal_directory, entry->d_name, 0);
+                    }
+                }
+                offset += entry->d_reclen;
+            }
+        }
+    }
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+}
+
+}  // namespace
+
+TemporariesRemovedOnSignal::TemporariesRemovedOnSignal(const std::filesystem::path& exr_path) {
+    const fs::path directory =
+        exr_path.parent_path().empty() ? fs::path(".") : exr_path.parent_path();
+    signal_directory = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    signal_prefix_count = 0;
+    // exr.cpp's TemporaryFile names: ".<target name>.tmp-<pid>-<counter>".
+    for (const fs::path& target :
+         {exr_path, colour_preview_path(exr_path), cost_preview_path(exr_path)}) {
+        const std::string prefix =
+            "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-";
+        if (prefix.size() >= sizeof signal_prefixes[0]) continue;
+        std::memcpy(signal_prefixes[signal_prefix_count], prefix.c_str(), prefix.size() + 1);
+        ++signal_prefix_count;
+    }
+    struct sigaction action {};
+    action.sa_handler = remove_temporaries_and_die;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(SIGINT, &action, &previous_interrupt);
+    ::sigaction(SIGTERM, &action, &previous_terminate);
+}
+
+TemporariesRemovedOnSignal::~TemporariesRemovedOnSignal() {
+    ::sigaction(SIGINT, &previous_interrupt, nullptr);
+    ::sigaction(SIGTERM, &previous_terminate, nullptr);
+    if (signal_directory >= 0) ::close(signal_directory);
+    signal_directory = -1;
+    signal_prefix_count = 0;
+}
 
 int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
     CLI::App app{

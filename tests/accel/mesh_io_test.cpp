@@ -2,9 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
 #include <Eigen/Geometry>
+
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <set>
+#include <sstream>
 
 #include "csgrt/accel/mesh_tools.h"
 #include "csgrt/core/error.h"
@@ -218,6 +224,121 @@ TEST(MeshIo, MissingDirectoryAndUnknownFilesAreErrors) {
     expect_error(kFixtures / "no_such_mesh.off", "no such file");
     expect_error(kFixtures / "malformed", "not a regular file");
     expect_error(kFixtures / "make_fixtures.py", "unsupported extension");
+}
+
+/// A scratch folder of this test, removed on destruction.
+class ScratchFolder {
+public:
+    ScratchFolder()
+        : path_(std::filesystem::temp_directory_path() /
+                ("csgrt_mesh_io_" + std::to_string(::getpid()) + "_" +
+                 ::testing::UnitTest::GetInstance()->current_test_info()->name())) {
+        std::filesystem::create_directories(path_);
+    }
+    ~ScratchFolder() {
+        std::error_code ignored;
+        std::filesystem::remove_all(path_, ignored);
+    }
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
+
+std::string mesh_error(const std::filesystem::path& path) {
+    try {
+        load_mesh(path);
+    } catch (const MeshError& error) {
+        return error.what();
+    }
+    return "no error";
+}
+
+std::string read_text(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(MeshIo, FifosDevicesAndNulBytesAreRefusedBeforeOpening) {
+    // Opening a FIFO would block until a writer came, and a device never ends: both are
+    // refused from the file's status alone, so this test returns at once.
+    ScratchFolder folder;
+    const std::filesystem::path fifo = folder.path() / "pipe.off";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    EXPECT_NE(mesh_error(fifo).find("a FIFO, not a regular file"), std::string::npos)
+        << mesh_error(fifo);
+    EXPECT_NE(mesh_error("/dev/zero").find("a device, not a regular file"), std::string::npos);
+    EXPECT_NE(mesh_error("/dev/urandom").find("a device"), std::string::npos);
+    EXPECT_NE(mesh_error(folder.path()).find("a directory"), std::string::npos);
+    // std::filesystem keeps the NUL; the C library would open "box" and stop there.
+    const std::string with_nul = (kFixtures / "box").string() + std::string(1, '\0') + ".off";
+    EXPECT_NE(mesh_error(with_nul).find("NUL byte"), std::string::npos) << mesh_error(with_nul);
+}
+
+TEST(MeshIo, ALineLongerThanOneMebibyteIsRefusedWithoutReadingTheRest) {
+    ScratchFolder folder;
+    const std::filesystem::path path = folder.path() / "long.obj";
+    {
+        std::ofstream out(path, std::ios::binary);
+        out << "v 0 0 0\n# " << std::string(3u << 20, 'x');  // 3 MiB, no newline
+    }
+    const std::string message = mesh_error(path);
+    EXPECT_NE(message.find("line 2: longer than 1048576 bytes"), std::string::npos) << message;
+}
+
+TEST(MeshIo, PlyFormatVersionOneWithoutDecimalsLoadsAsTheToolsReadIt) {
+    // "format ascii 1" is what some exporters write; OpenMesh and assimp read it as 1.0.
+    ScratchFolder folder;
+    std::string text = read_text(kFixtures / "box_ascii.ply");
+    const std::size_t at = text.find("format ascii 1.0");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 16, "format ascii 1");
+    const std::filesystem::path path = folder.path() / "box.ply";
+    std::ofstream(path, std::ios::binary) << text;
+    MeshReport report, reference;
+    const TriangleMeshData mesh = load_mesh(path, &report);
+    const TriangleMeshData expected = load_mesh(kFixtures / "box_ascii.ply", &reference);
+    EXPECT_EQ(mesh.vertices, expected.vertices);
+    EXPECT_EQ(mesh.triangles, expected.triangles);
+    EXPECT_EQ(report.faces, reference.faces);
+    // Other versions stay refused: the format has only 1.0.
+    text.replace(at, 14, "format ascii 2");
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+    EXPECT_NE(mesh_error(path).find("expected 'format <type> 1.0'"), std::string::npos);
+}
+
+TEST(MeshIo, AsciiStlWithSeveralSolidsIsOneMesh) {
+    // The fixture's 12 facets, then the same box moved by 10 in x as a second solid: 24
+    // triangles, two closed components, as exporters write several parts.
+    ScratchFolder folder;
+    const std::string box = read_text(kFixtures / "box_ascii.stl");
+    std::string moved;
+    std::istringstream lines(box);
+    for (std::string line; std::getline(lines, line);) {
+        std::istringstream words(line);
+        std::string keyword;
+        words >> keyword;
+        if (keyword == "vertex") {
+            double x, y, z;
+            words >> x >> y >> z;
+            std::ostringstream shifted;
+            shifted << "      vertex " << x + 10 << ' ' << y << ' ' << z;
+            line = shifted.str();
+        }
+        moved += line + "\n";
+    }
+    const std::filesystem::path path = folder.path() / "two.stl";
+    std::ofstream(path, std::ios::binary) << box << "\n" << moved;
+    MeshReport report;
+    const TriangleMeshData mesh = load_mesh(path, &report);
+    EXPECT_EQ(report.faces, 24u);
+    EXPECT_EQ(mesh.triangles.size(), 24u);
+    EXPECT_EQ(report.components, 2u);
+    EXPECT_TRUE(report.is_closed);
+    // Something else after 'endsolid' is still refused, at its line.
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << box << "facet normal 0 0 1\n";
+    EXPECT_NE(mesh_error(path).find("expected 'solid' or the end of the file"), std::string::npos)
+        << mesh_error(path);
 }
 
 TEST(MeshIo, OpenMeshPrintsNothing) {

@@ -16,6 +16,7 @@
 #include "csgrt/core/error.h"
 #include "csgrt/csg/scene.h"
 #include "csgrt/csg/scene_file.h"
+#include "csgrt/render/renderer.h"
 
 namespace csgrt::fuzz {
 
@@ -46,7 +47,9 @@ void shoot_rays(const Aabb& bounds, Query&& query) {
 
 /// The scene fuzz target's body: parses `text` as a scene file (mesh paths relative to
 /// `directory`); a SceneError is the expected answer to bad input, anything else escaping is a
-/// defect. A scene that loads is committed and queried. Returns whether it loaded.
+/// defect. A scene that loads is counted as `csgrt info` counts it, committed, queried and
+/// rendered at 4x3 pixels on one thread (what `csgrt render` does, so a scene that loads but
+/// hangs or blows up the renderer is found). Returns whether it loaded.
 inline bool run_scene(std::string_view text, const std::filesystem::path& directory) {
     std::optional<Scene> scene;
     try {
@@ -59,11 +62,17 @@ inline bool run_scene(std::string_view text, const std::filesystem::path& direct
     } catch (const InvalidParameter&) {
         return true;  // an unusable camera is reported by commit, as documented
     }
+    (void)count_scene_shapes(*scene);
     QueryScratch scratch;
     shoot_rays(scene->bounds(), [&](const Ray& ray) {
         (void)scene->intersect(ray, scratch);
         (void)scene->occluded(ray, scratch);
     });
+    RenderSettings settings;
+    settings.width = 4;
+    settings.height = 3;
+    settings.threads = 1;
+    (void)render(*scene, settings);
     return true;
 }
 

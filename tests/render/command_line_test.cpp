@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <iterator>
 
 #include <algorithm>
 #include <cstdlib>
@@ -237,6 +241,106 @@ TEST_F(CommandLine, AnOutputThatIsADirectoryIsRefusedBeforeRendering) {
     fs::create_directory(directory_ / "out.png");
     expect_one_line_error(run({"render", scene_, "-o", output_}), "is a directory");
     EXPECT_EQ(names_in(directory_), (std::vector<std::string>{"out.png", "scene.json"}));
+}
+
+TEST_F(CommandLine, AnOutputThatIsTheSceneIsRefusedInEverySpelling) {
+    // A scene named .exr (valid JSON): rendering onto it would replace the scene.
+    const fs::path scene = directory_ / "scene.exr";
+    std::ofstream(scene) << kSceneText;
+    const fs::path other_spelling = directory_ / ".." / directory_.filename() / "." / "scene.exr";
+    fs::create_symlink(scene, directory_ / "link.exr");
+    for (const fs::path& output : {scene, other_spelling, directory_ / "link.exr"}) {
+        const ProgramRun result = run({"render", scene.string(), "-o", output.string()});
+        expect_one_line_error(result, "is the scene file");
+    }
+    std::ifstream in(scene);
+    const std::string kept{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    EXPECT_EQ(kept, kSceneText);
+    fs::remove(scene);
+    fs::remove(directory_ / "link.exr");
+    expect_no_output();
+}
+
+TEST_F(CommandLine, AnUnwritableOutputFolderIsRefusedBeforeRendering) {
+    const fs::path folder = directory_ / "read_only";
+    fs::create_directory(folder);
+    fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec);
+    if (::access(folder.c_str(), W_OK) == 0) {
+        fs::permissions(folder, fs::perms::owner_all);
+        GTEST_SKIP() << "running as root: every folder is writable";
+    }
+    const ProgramRun result = run({"render", scene_, "-o", (folder / "out.exr").string()});
+    fs::permissions(folder, fs::perms::owner_all);
+    expect_one_line_error(result, "' is not writable: Permission denied");
+}
+
+TEST_F(CommandLine, AnImageLargerThanMemoryIsRefusedWithTheEstimate) {
+    // 640 x 480 pixels of 40 bytes (every channel) plus 16 for writing: 17,203,200 bytes,
+    // 17 MiB rounded up, against a 1 MiB budget.
+    const char* argv[] = {"csgrt", "render", scene_.c_str(), "-o", output_.c_str()};
+    std::ostringstream out, err;
+    CommandLineStreams streams{out, err};
+    streams.memory_bytes = 1u << 20;
+    EXPECT_EQ(run_csgrt(5, argv, streams), 1);
+    EXPECT_NE(
+        err.str().find("a 640x480 image needs about 17 MiB, more than the 1 MiB of memory free"),
+        std::string::npos)
+        << err.str();
+    expect_no_output();
+}
+
+TEST_F(CommandLine, TemporaryFilesAreRemovedOnSigtermAndSigint) {
+    for (const int signal : {SIGTERM, SIGINT}) {
+        int ready[2];
+        ASSERT_EQ(::pipe(ready), 0);
+        const pid_t child = ::fork();
+        ASSERT_GE(child, 0);
+        if (child == 0) {
+            // What write_render_files leaves while it writes (exr.cpp's names), then the signal.
+            const TemporariesRemovedOnSignal guard(output_);
+            const std::string pid = std::to_string(::getpid());
+            std::ofstream(directory_ / (".out.exr.tmp-" + pid + "-0")) << "partial";
+            std::ofstream(directory_ / (".out.png.tmp-" + pid + "-1")) << "partial";
+            std::ofstream(directory_ / (".out.cost.png.tmp-" + pid + "-2")) << "partial";
+            const char byte = 1;
+            (void)!::write(ready[1], &byte, 1);
+            ::pause();
+            ::_exit(3);  // not reached: the signal ends the process
+        }
+        char byte = 0;
+        ASSERT_EQ(::read(ready[0], &byte, 1), 1);
+        ::close(ready[0]);
+        ::close(ready[1]);
+        ASSERT_EQ(::kill(child, signal), 0);
+        int status = 0;
+        ASSERT_EQ(::waitpid(child, &status, 0), child);
+        // Killed by the signal itself, as without the handler, and nothing left behind.
+        EXPECT_TRUE(WIFSIGNALED(status)) << status;
+        EXPECT_EQ(WTERMSIG(status), signal);
+        expect_no_output();
+    }
+}
+
+TEST_F(CommandLine, InfoCountsAnExpansionOfAMillionLeavesWithoutWalkingIt) {
+    // d_k = compound [d_{k-1}, d_{k-1}] over a sphere: 2^20 leaves, 21 distinct shapes.
+    std::string text = R"({"definitions": {"d0": {"type": "sphere", "radius": 1})";
+    for (int k = 1; k <= 20; ++k) {
+        const std::string below = std::string("d").append(std::to_string(k - 1));
+        // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on chained string +.
+        text.append(", \"d").append(std::to_string(k));
+        text.append(R"(": {"type": "compound", "children": [{"type": "ref", "definition": ")");
+        text.append(below).append(R"("}, {"type": "ref", "definition": ")").append(below);
+        text.append(R"("}]})");
+    }
+    std::ofstream(scene_, std::ios::trunc)
+        << text << R"(}, "objects": [{"type": "ref", "definition": "d20"}]})";
+    const ProgramRun result = run({"info", scene_});
+    ASSERT_EQ(result.status, 0) << result.err;
+    for (const char* fragment :
+         {"2097151 shapes in the trees under them (1048576 leaves)",
+          "  compound           1048575\n", "  sphere             1048576\n"}) {
+        EXPECT_NE(result.out.find(fragment), std::string::npos) << fragment << "\n" << result.out;
+    }
 }
 
 TEST_F(CommandLine, TheProgressBarAppearsOnATerminalOnlyAfterTheDelay) {

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <map>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -30,6 +32,25 @@ Scene load_scene(const std::filesystem::path& path);
 /// to `directory`.
 Scene load_scene_from_string(std::string_view text, const std::string& name,
                              const std::filesystem::path& directory = {});
+
+/// The shapes in the trees under a scene's objects as a render meets them: every grid copy
+/// and every use of a shared definition counts. Computed once per distinct shape in memory
+/// (memoised), so it costs time linear in what was loaded, not in the expansion, which a
+/// file may make 2^64 leaves large (the loader refuses more than docs/scene-format.md's
+/// limit). Counts saturate at 2^64 - 1.
+struct SceneShapeCounts {
+    /// Shapes of each kind() ("sphere", "instance", "union", ...).
+    std::map<std::string, std::uint64_t> by_kind;
+    /// Every node: the sum of by_kind.
+    std::uint64_t shapes = 0;
+    /// Shapes with no children() (what a ray can finally be tested against).
+    std::uint64_t leaves = 0;
+    /// Triangles of the meshes, each mesh once per use.
+    std::uint64_t triangles = 0;
+};
+
+/// Counts `scene`'s shapes (`csgrt info`).
+SceneShapeCounts count_scene_shapes(const Scene& scene);
 
 /// Every value the "type" of a scene-file shape may have, in the order the format lists them.
 std::span<const std::string_view> scene_shape_types();

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cstdint>
+#include <filesystem>
 #include <iosfwd>
 
 namespace csgrt {
@@ -12,6 +14,20 @@ struct CommandLineStreams {
     std::ostream& err;
     bool err_is_terminal = false;
     double progress_delay_seconds = 1.0;
+    /// Memory a render's image may take; 0 means the machine's free memory at the start. A larger
+    /// image is refused before rendering, with the estimate.
+    std::uint64_t memory_bytes = 0;
+};
+
+/// While alive, SIGINT and SIGTERM first remove the temporary files that write_render_files
+/// makes beside `exr_path` (and its previews), then end the process as the signal would have;
+/// the previous handlers come back on destruction. One at a time per process.
+class TemporariesRemovedOnSignal {
+public:
+    explicit TemporariesRemovedOnSignal(const std::filesystem::path& exr_path);
+    ~TemporariesRemovedOnSignal();
+    TemporariesRemovedOnSignal(const TemporariesRemovedOnSignal&) = delete;
+    TemporariesRemovedOnSignal& operator=(const TemporariesRemovedOnSignal&) = delete;
 };
 
 /// The csgrt program (docs/rendering.md): `render SCENE.json -o OUT.exr [options]`,
