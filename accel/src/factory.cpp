@@ -1,8 +1,14 @@
 #include "csgrt/accel/factory.h"
 
+#include <algorithm>
 #include <array>
 #include <string>
 
+#include "csgrt/accel/brute_force.h"
+#include "csgrt/accel/bvh.h"
+#include "csgrt/accel/hierarchical_grid.h"
+#include "csgrt/accel/ray_classification.h"
+#include "csgrt/accel/regular_grid.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
@@ -36,6 +42,24 @@ std::unique_ptr<Accelerator<Set>> make_accelerator(std::string_view name, const 
     for (std::string_view n : kNames) known.append(known.empty() ? "" : ", ").append(n);
     require(false, "make_accelerator", "name", "one of " + known, std::string(name));
     return nullptr;
+}
+
+std::string choose_accelerator(std::size_t count, std::string& reason) {
+    if (count <= kHandfulOfMembers) {
+        reason = std::to_string(count) + " bounded member" + (count == 1 ? "" : "s") +
+                 " (at most " + std::to_string(kHandfulOfMembers) +
+                 "): tested directly, no hierarchy";
+        return "brute";
+    }
+    const auto names = accelerator_names();
+    if (std::find(names.begin(), names.end(), "bvh") != names.end()) {
+        reason = std::to_string(count) + " bounded members: a BVH over their boxes";
+        return "bvh";
+    }
+    reason = std::to_string(count) +
+             " bounded members: brute force, because this build has no BVH (\"bvh\" is not "
+             "registered with make_accelerator)";
+    return "brute";
 }
 
 template std::unique_ptr<Accelerator<TriangleSet<float>>> make_accelerator(

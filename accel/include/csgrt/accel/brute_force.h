@@ -3,15 +3,11 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/core/aabb.h"
 
 namespace csgrt {
 
-struct BruteForceConfig {
-    /// Test each primitive's bounding box before the primitive: measures what bounding boxes
-    /// alone buy (the seed's first speed-up) against the plain loop.
-    bool box_culling = false;
-};
 
 /// Every primitive, every ray: the baseline of every speed-up and the oracle the other
 /// structures are tested against.

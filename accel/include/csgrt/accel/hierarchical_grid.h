@@ -5,26 +5,11 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/accel/regular_grid.h"
 
 namespace csgrt {
 
-struct HierarchicalGridConfig {
-    /// The top grid has about N^top_cells_exponent cells for N primitives. Ize, Shirley and
-    /// Parker, "Grid Creation Strategies for Efficient Ray Tracing", 2007, derive N^0.6 for
-    /// one level of nesting (N^(3 / (3 + 2 d)) for d levels). In [0, 1].
-    double top_cells_exponent = 0.6;
-    /// Cells listing more than this many primitives are considered for a sub-grid (>= 1).
-    int max_primitives_per_cell = 16;
-    /// Density of each sub-grid, in cells per primitive of the cell it refines (> 0).
-    double sub_cells_per_primitive = 2.0;
-    /// Most levels of sub-grids below the top grid, in [0, 8] (0: a plain grid).
-    int max_depth = 3;
-    /// Most cells along one axis of any one grid (>= 1).
-    int max_resolution = 128;
-    /// As GridConfig::triangle_box_test, at every level.
-    bool triangle_box_test = true;
-};
 
 /// A hierarchy of uniform grids after Jevans & Wyvill, "Adaptive Voxel Subdivision for Ray
 /// Tracing", Graphics Interface 1989: a coarse top grid (N^0.6 cells, Ize et al. 2007) whose

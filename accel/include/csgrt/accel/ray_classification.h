@@ -12,45 +12,13 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/accel/bvh_build.h"
 #include "csgrt/core/aabb.h"
 
 namespace csgrt {
 
-/// How a ray-space cell picks the axis it is halved along.
-enum class RayClassificationSplit {
-    /// x, y, z, u, v in turn, by depth (Arvo & Kirk's order).
-    kCycle,
-    /// The axis whose halving narrows the cell's beam the most: the beam's width across the
-    /// rays is estimated from the origin extents, the origin extent along the face axis seen
-    /// at the rays' slope, and the direction extents times how far the rays can still travel
-    /// through the scene (docs/structures.md).
-    kNarrowBeam,
-};
 
-struct RayClassificationConfig {
-    /// A leaf that a ray reaches is split while its candidates hold more primitives than this.
-    std::uint32_t max_leaf_candidates = 16;
-    /// The deepest a face's tree may grow (halvings from its root), at most 60; 0 chooses
-    /// round(2.4 log2 n) for n primitives (38 for 50k), about where a cell's beam narrows to
-    /// the size of one primitive of an evenly tessellated surface.
-    int max_depth = 0;
-    /// Cap on the bytes of all candidate lists and cells, the six roots included. Once it is
-    /// reached cells stop splitting, and a new cell whose list would not fit searches its
-    /// parent's list; stats() reports how often either happened. Answers stay exact whatever
-    /// the cap (0: the six root cells only).
-    std::size_t max_candidate_bytes = std::size_t{256} << 20;
-    RayClassificationSplit split = RayClassificationSplit::kNarrowBeam;
-    /// A leaf is split only once this many queries have searched it, so a cell that few
-    /// incoherent rays reach is searched, not refined for nobody (>= 1; 1: at the first).
-    std::uint32_t visits_before_split = 64;
-    /// A candidate cluster is replaced by its two halves while it is wider across the rays
-    /// than this many times the cell's beam (> 0): smaller values give longer, tighter lists.
-    double cluster_width = 2.0;
-    /// Subdivide every cell with more than max_leaf_candidates primitives down to this depth
-    /// during build(), before any ray arrives (0: purely lazy).
-    int build_depth = 0;
-};
 
 namespace detail {
 

@@ -6,25 +6,11 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/core/aabb.h"
 
 namespace csgrt {
 
-struct GridConfig {
-    /// Target number of cells per primitive (the grid density): the cell edge is
-    /// a = cbrt(V / (cells_per_primitive N)) for N primitives in a box of volume V, so the grid
-    /// has about cells_per_primitive N cells. The literature writes a = cbrt(lambda V / N), with
-    /// lambda = 1 / cells_per_primitive; Ize et al. 2007 show Theta(N) cells is right for
-    /// well-shaped meshes. Must be > 0.
-    double cells_per_primitive = 8.0;
-    /// Most cells along one axis (the clamp of the per-axis counts), >= 1. Keeps memory bounded
-    /// for very elongated or very large scenes.
-    int max_resolution = 256;
-    /// For triangle sets: reference a triangle only from the cells the triangle itself
-    /// overlaps (Akenine-Moeller, "Fast 3D Triangle-Box Overlap Testing", JGT 2001), not from
-    /// every cell of its bounding box. Long, thin, diagonal triangles touch far fewer cells.
-    bool triangle_box_test = true;
-};
 
 namespace detail {
 
