@@ -10,7 +10,6 @@
 
 namespace csgrt {
 
-
 /// A hierarchy of uniform grids after Jevans & Wyvill, "Adaptive Voxel Subdivision for Ray
 /// Tracing", Graphics Interface 1989: a coarse top grid (N^0.6 cells, Ize et al. 2007) whose
 /// crowded cells hold grids of their own, recursively. Unlike Klimaszewski & Sederberg, "Faster
@@ -25,20 +24,15 @@ namespace csgrt {
 /// every level, descending into sub-grids, with one mailbox and one stopping rule for the whole
 /// ray.
 template <class Set>
-class HierarchicalGrid final : public Accelerator<Set> {
+class HierarchicalGrid final : public AcceleratorBase<HierarchicalGrid<Set>, Set> {
 public:
     void build(const Set& set, const HierarchicalGridConfig& config = {});
 
-    std::string_view name() const override { return "hgrid"; }
-    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
-    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                           TraversalCounters& counters) const override;
-    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
-                          TraversalCounters& counters) const override;
-    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                  QueryScratch& scratch) const override;
-    AcceleratorStats stats() const override { return stats_; }
+    static constexpr std::string_view kName = "hgrid";
+    /// Every query (the Accelerator overrides come from AcceleratorBase).
+    template <QueryKind kKind, bool kCounted>
+    bool query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+               TraversalCounters& counters) const;
 
     /// Number of grids (the top grid is grid 0).
     std::size_t grid_count() const { return grids_.size(); }
@@ -78,6 +72,8 @@ private:
                         TraversalCounters& counters) const;
     template <bool kCount>
     bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
+    using AcceleratorBase<HierarchicalGrid<Set>, Set>::stats_;
 
     const Set* set_ = nullptr;
     HierarchicalGridConfig config_;
@@ -87,7 +83,6 @@ private:
     std::vector<Cell> cells_;
     std::vector<std::uint32_t> primitives_;
     std::vector<std::uint32_t> unbounded_;
-    AcceleratorStats stats_;
 };
 
 class ShapeSet;

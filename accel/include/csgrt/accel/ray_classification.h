@@ -18,8 +18,6 @@
 
 namespace csgrt {
 
-
-
 namespace detail {
 
 /// The face of the direction cube a direction points through, and its coordinates on it: the
@@ -115,7 +113,7 @@ inline bool beam_may_hit(const RayCell& cell, const Aabb& box) {
 /// Hypercubes are split lazily, when rays reach them; lazy splitting is thread-safe, and once
 /// a path is built queries take no lock (docs/structures.md).
 template <class Set>
-class RayClassification final : public Accelerator<Set> {
+class RayClassification final : public AcceleratorBase<RayClassification<Set>, Set> {
 public:
     RayClassification();
     ~RayClassification() override;
@@ -130,15 +128,11 @@ public:
     /// lazy build apart from the queries. Safe alongside queries.
     void prebuild(std::span<const Ray> rays);
 
-    std::string_view name() const override { return "rayclass"; }
-    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
-    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                           TraversalCounters& counters) const override;
-    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
-                          TraversalCounters& counters) const override;
-    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                  QueryScratch& scratch) const override;
+    static constexpr std::string_view kName = "rayclass";
+    /// Every query (the Accelerator overrides come from AcceleratorBase).
+    template <QueryKind kKind, bool kCounted>
+    bool query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+               TraversalCounters& counters) const;
     /// The current figures: they grow as rays split cells.
     AcceleratorStats stats() const override;
 
@@ -199,6 +193,7 @@ private:
                         TraversalCounters& counters) const;
     template <bool kCount>
     bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
 
     const Set* set_ = nullptr;
     RayClassificationConfig config_;

@@ -11,7 +11,6 @@
 
 namespace csgrt {
 
-
 namespace detail {
 
 /// The cells of one uniform grid: a box cut into resolution[0] x resolution[1] x resolution[2]
@@ -63,20 +62,15 @@ GridGeometry choose_grid_geometry(const Aabb& bounds, std::size_t count, double 
 /// skips most repeated tests of primitives that span several cells and keeps queries
 /// thread-safe. Primitives with unbounded or empty boxes are tested by every ray.
 template <class Set>
-class RegularGrid final : public Accelerator<Set> {
+class RegularGrid final : public AcceleratorBase<RegularGrid<Set>, Set> {
 public:
     void build(const Set& set, const GridConfig& config = {});
 
-    std::string_view name() const override { return "grid"; }
-    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
-    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                           TraversalCounters& counters) const override;
-    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
-                          TraversalCounters& counters) const override;
-    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                  QueryScratch& scratch) const override;
-    AcceleratorStats stats() const override { return stats_; }
+    static constexpr std::string_view kName = "grid";
+    /// Every query (the Accelerator overrides come from AcceleratorBase).
+    template <QueryKind kKind, bool kCounted>
+    bool query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+               TraversalCounters& counters) const;
 
     /// The grid's cells (box, resolution, cell size), for tests and reports.
     const detail::GridGeometry& geometry() const { return geometry_; }
@@ -97,6 +91,8 @@ private:
                         TraversalCounters& counters) const;
     template <bool kCount>
     bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
+    using AcceleratorBase<RegularGrid<Set>, Set>::stats_;
     bool is_occupied(std::size_t cell) const { return (occupied_[cell / 64] >> (cell % 64)) & 1; }
 
     const Set* set_ = nullptr;
@@ -114,7 +110,6 @@ private:
     /// cell: the walk jumps over the empty cells around a cell in one step.
     std::vector<std::uint8_t> empty_radius_;
     std::vector<std::uint32_t> unbounded_;
-    AcceleratorStats stats_;
 };
 
 class ShapeSet;
