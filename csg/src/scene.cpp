@@ -48,9 +48,9 @@ void Scene::commit(const SceneConfig& config) {
     std::vector<std::shared_ptr<const Shape>> shapes;
     shapes.reserve(objects_.size());
     for (const SceneObject& object : objects_) shapes.push_back(object.shape);
-    auto group = std::make_shared<const ShapeGroup>(shapes, config.accelerator,
-                                                    config.accelerator_config,
-                                                    "requested in the scene configuration");
+    auto group =
+        std::make_shared<const ShapeGroup>(shapes, config.accelerator, config.accelerator_config,
+                                           "requested in the scene configuration");
     std::string reason = group->accelerator_reason();
     if (!group->unbounded().empty()) {
         reason += "; " + std::to_string(group->unbounded().size()) +

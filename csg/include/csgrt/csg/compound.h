@@ -25,9 +25,9 @@ struct CompoundConfig {
 /// A plain group of shapes (Suffern, "Ray Tracing from the Ground Up", 2007, ch. 19): the
 /// nearest hit among the children, no boolean. The children form a ShapeGroup (csg/shape_group.h):
 /// the bounded ones sit in an acceleration structure built through make_accelerator; unbounded
-/// ones (planes) are kept apart and asked on every ray. A compound is itself a shape with a box, so compounds of
-/// compounds form a hierarchy of bounding boxes: a ray that misses a compound's box costs one
-/// box test, whatever is inside.
+/// ones (planes) are kept apart and asked on every ray. A compound is itself a shape with a box, so
+/// compounds of compounds form a hierarchy of bounding boxes: a ray that misses a compound's box
+/// costs one box test, whatever is inside.
 ///
 /// Hits carry `object` = the index of the child they belong to (an enclosing set overwrites it
 /// with its own member index); at equal t the lower child index wins.

@@ -74,8 +74,9 @@ public:
 
     /// Builds everything queries need: validates the camera, computes the bounds, and builds
     /// the objects' ShapeGroup (csg/shape_group.h), a structure over the bounded objects
-    /// ("auto": choose_accelerator in accel/factory.h, documented in docs/scene.md). Throws InvalidParameter for an invalid camera or an
-    /// unknown structure name; the scene is then left uncommitted.
+    /// ("auto": choose_accelerator in accel/factory.h, documented in docs/scene.md). Throws
+    /// InvalidParameter for an invalid camera or an unknown structure name; the scene is then left
+    /// uncommitted.
     void commit(const SceneConfig& config = {});
     bool is_committed() const { return committed_; }
 
