@@ -14,8 +14,9 @@ ShapeGroup::ShapeGroup(std::span<const std::shared_ptr<const Shape>> members,
             members.size());
     std::vector<std::shared_ptr<const Shape>> bounded;
     for (std::size_t i = 0; i < members.size(); ++i) {
-        require(members[i] != nullptr, "ShapeGroup", "member " + std::to_string(i), "a shape",
-                "null");
+        // Tested before the message is built: a scene commits tens of thousands of members.
+        if (members[i] == nullptr)
+            require(false, "ShapeGroup", "member " + std::to_string(i), "a shape", "null");
         const Aabb box = members[i]->bounds();
         if (box.is_empty()) continue;
         if (box.is_finite()) {
