@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "accelerator_base.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 
@@ -26,30 +27,6 @@ void BruteForce<Set>::build(const Set& set, const BruteForceConfig& config) {
 }
 
 template <class Set>
-bool BruteForce<Set>::intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return intersect_impl<false>(ray, record, scratch, unused);
-}
-
-template <class Set>
-bool BruteForce<Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return occluded_impl<false>(ray, scratch, unused);
-}
-
-template <class Set>
-bool BruteForce<Set>::intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                                        TraversalCounters& counters) const {
-    return intersect_impl<true>(ray, record, scratch, counters);
-}
-
-template <class Set>
-bool BruteForce<Set>::occluded_counted(const Ray& ray, QueryScratch& scratch,
-                                       TraversalCounters& counters) const {
-    return occluded_impl<true>(ray, scratch, counters);
-}
-
-template <class Set>
 bool BruteForce<Set>::may_hit(std::size_t i, const Ray& ray, const Vector3& inverse_direction,
                               double t_max) const {
     if (!config_.box_culling) return true;
@@ -60,9 +37,9 @@ bool BruteForce<Set>::may_hit(std::size_t i, const Ray& ray, const Vector3& inve
 }
 
 template <class Set>
-template <bool kCount>
-bool BruteForce<Set>::intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                                     TraversalCounters& counters) const {
+template <QueryKind kKind, bool kCounted>
+bool BruteForce<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+                            TraversalCounters& counters) const {
     if (set_ == nullptr || !is_valid(ray)) return false;
     const auto prepared = set_->prepare(ray, scratch);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
@@ -70,47 +47,34 @@ bool BruteForce<Set>::intersect_impl(const Ray& ray, HitRecord& record, QueryScr
     best.t = ray.t_max;
     bool found = false;
     for (std::size_t i = 0; i < set_->size(); ++i) {
-        if constexpr (kCount) counters.boxes_tested += config_.box_culling ? 1 : 0;
+        if constexpr (kCounted) counters.boxes_tested += config_.box_culling ? 1 : 0;
+        // Only the nearest-hit query narrows the interval as it goes.
         if (!may_hit(i, ray, inverse_direction, best.t)) continue;
-        if constexpr (kCount) ++counters.primitives_tested;
-        found |= set_->intersect(i, prepared, best);
+        if constexpr (kCounted) ++counters.primitives_tested;
+        if constexpr (kKind == QueryKind::kNearest) {
+            found |= set_->intersect(i, prepared, best);
+        } else if constexpr (kKind == QueryKind::kAny) {
+            if (set_->occluded(i, prepared)) return true;
+        } else {
+            HitRecord record;
+            record.t = ray.t_max;
+            if (set_->intersect(i, prepared, record)) {
+                answer.push_back(record);
+                found = true;
+            }
+        }
     }
-    if (found) record = best;
+    if constexpr (kKind == QueryKind::kNearest) {
+        if (found) answer = best;
+    }
     return found;
-}
-
-template <class Set>
-template <bool kCount>
-bool BruteForce<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
-                                    TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return false;
-    const auto prepared = set_->prepare(ray, scratch);
-    const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    for (std::size_t i = 0; i < set_->size(); ++i) {
-        if constexpr (kCount) counters.boxes_tested += config_.box_culling ? 1 : 0;
-        if (!may_hit(i, ray, inverse_direction, ray.t_max)) continue;
-        if constexpr (kCount) ++counters.primitives_tested;
-        if (set_->occluded(i, prepared)) return true;
-    }
-    return false;
-}
-
-template <class Set>
-void BruteForce<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                               QueryScratch& scratch) const {
-    if (set_ == nullptr || !is_valid(ray)) return;
-    const auto prepared = set_->prepare(ray, scratch);
-    const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    for (std::size_t i = 0; i < set_->size(); ++i) {
-        if (!may_hit(i, ray, inverse_direction, ray.t_max)) continue;
-        HitRecord record;
-        record.t = ray.t_max;
-        if (set_->intersect(i, prepared, record)) hits.push_back(record);
-    }
 }
 
 template class BruteForce<TriangleSet<float>>;
 template class BruteForce<TriangleSet<double>>;
 template class BruteForce<ShapeSet>;
+template class AcceleratorBase<BruteForce<TriangleSet<float>>, TriangleSet<float>>;
+template class AcceleratorBase<BruteForce<TriangleSet<double>>, TriangleSet<double>>;
+template class AcceleratorBase<BruteForce<ShapeSet>, ShapeSet>;
 
 }  // namespace csgrt

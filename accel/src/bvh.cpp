@@ -11,6 +11,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "accelerator_base.h"
 #include "bvh_simd.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
@@ -869,38 +870,26 @@ void Bvh<Set>::fill_blocks(const Set& set, detail::BinaryBvh& tree, bool paralle
 }
 
 template <class Set>
-bool Bvh<Set>::intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return detail::BvhTraversal<Set>::template intersect<false>(*this, ray, record, scratch,
-                                                                unused);
-}
-
-template <class Set>
-bool Bvh<Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return detail::BvhTraversal<Set>::template occluded<false>(*this, ray, scratch, unused);
-}
-
-template <class Set>
-bool Bvh<Set>::intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                                 TraversalCounters& counters) const {
-    return detail::BvhTraversal<Set>::template intersect<true>(*this, ray, record, scratch,
-                                                               counters);
-}
-
-template <class Set>
-bool Bvh<Set>::occluded_counted(const Ray& ray, QueryScratch& scratch,
-                                TraversalCounters& counters) const {
-    return detail::BvhTraversal<Set>::template occluded<true>(*this, ray, scratch, counters);
-}
-
-template <class Set>
-void Bvh<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const {
-    detail::BvhTraversal<Set>::all_hits(*this, ray, hits, scratch);
+template <QueryKind kKind, bool kCounted>
+bool Bvh<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+                     TraversalCounters& counters) const {
+    using Traversal = detail::BvhTraversal<Set>;
+    if constexpr (kKind == QueryKind::kNearest) {
+        return Traversal::template intersect<kCounted>(*this, ray, answer, scratch, counters);
+    } else if constexpr (kKind == QueryKind::kAny) {
+        return Traversal::template occluded<kCounted>(*this, ray, scratch, counters);
+    } else {
+        const std::size_t before = answer.size();
+        Traversal::all_hits(*this, ray, answer, scratch);
+        return answer.size() > before;
+    }
 }
 
 template class Bvh<TriangleSet<float>>;
 template class Bvh<TriangleSet<double>>;
 template class Bvh<ShapeSet>;
+template class AcceleratorBase<Bvh<TriangleSet<float>>, TriangleSet<float>>;
+template class AcceleratorBase<Bvh<TriangleSet<double>>, TriangleSet<double>>;
+template class AcceleratorBase<Bvh<ShapeSet>, ShapeSet>;
 
 }  // namespace csgrt

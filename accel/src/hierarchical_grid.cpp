@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "accelerator_base.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
@@ -308,29 +309,18 @@ bool HierarchicalGrid<Set>::traverse(std::uint32_t grid_index, const Ray& ray,
 }
 
 template <class Set>
-bool HierarchicalGrid<Set>::intersect(const Ray& ray, HitRecord& record,
-                                      QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return intersect_impl<false>(ray, record, scratch, unused);
-}
-
-template <class Set>
-bool HierarchicalGrid<Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return occluded_impl<false>(ray, scratch, unused);
-}
-
-template <class Set>
-bool HierarchicalGrid<Set>::intersect_counted(const Ray& ray, HitRecord& record,
-                                              QueryScratch& scratch,
-                                              TraversalCounters& counters) const {
-    return intersect_impl<true>(ray, record, scratch, counters);
-}
-
-template <class Set>
-bool HierarchicalGrid<Set>::occluded_counted(const Ray& ray, QueryScratch& scratch,
-                                             TraversalCounters& counters) const {
-    return occluded_impl<true>(ray, scratch, counters);
+template <QueryKind kKind, bool kCounted>
+bool HierarchicalGrid<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+                                  TraversalCounters& counters) const {
+    if constexpr (kKind == QueryKind::kNearest) {
+        return intersect_impl<kCounted>(ray, answer, scratch, counters);
+    } else if constexpr (kKind == QueryKind::kAny) {
+        return occluded_impl<kCounted>(ray, scratch, counters);
+    } else {
+        const std::size_t before = answer.size();
+        all_hits_impl(ray, answer, scratch);
+        return answer.size() > before;
+    }
 }
 
 template <class Set>
@@ -358,8 +348,8 @@ bool HierarchicalGrid<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
 }
 
 template <class Set>
-void HierarchicalGrid<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                                     QueryScratch& scratch) const {
+void HierarchicalGrid<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits,
+                                          QueryScratch& scratch) const {
     if (set_ == nullptr || !is_valid(ray)) return;
     const auto prepared = set_->prepare(ray, scratch);
     const std::size_t first = hits.size();
@@ -372,5 +362,8 @@ void HierarchicalGrid<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hit
 template class HierarchicalGrid<TriangleSet<float>>;
 template class HierarchicalGrid<TriangleSet<double>>;
 template class HierarchicalGrid<ShapeSet>;
+template class AcceleratorBase<HierarchicalGrid<TriangleSet<float>>, TriangleSet<float>>;
+template class AcceleratorBase<HierarchicalGrid<TriangleSet<double>>, TriangleSet<double>>;
+template class AcceleratorBase<HierarchicalGrid<ShapeSet>, ShapeSet>;
 
 }  // namespace csgrt

@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "accelerator_base.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
@@ -556,29 +557,18 @@ inline double stop_position(double w_origin, double w_speed, double t) {
 }  // namespace
 
 template <class Set>
-bool RayClassification<Set>::intersect(const Ray& ray, HitRecord& record,
-                                       QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return intersect_impl<false>(ray, record, scratch, unused);
-}
-
-template <class Set>
-bool RayClassification<Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return occluded_impl<false>(ray, scratch, unused);
-}
-
-template <class Set>
-bool RayClassification<Set>::intersect_counted(const Ray& ray, HitRecord& record,
-                                               QueryScratch& scratch,
-                                               TraversalCounters& counters) const {
-    return intersect_impl<true>(ray, record, scratch, counters);
-}
-
-template <class Set>
-bool RayClassification<Set>::occluded_counted(const Ray& ray, QueryScratch& scratch,
-                                              TraversalCounters& counters) const {
-    return occluded_impl<true>(ray, scratch, counters);
+template <QueryKind kKind, bool kCounted>
+bool RayClassification<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer,
+                                   QueryScratch& scratch, TraversalCounters& counters) const {
+    if constexpr (kKind == QueryKind::kNearest) {
+        return intersect_impl<kCounted>(ray, answer, scratch, counters);
+    } else if constexpr (kKind == QueryKind::kAny) {
+        return occluded_impl<kCounted>(ray, scratch, counters);
+    } else {
+        const std::size_t before = answer.size();
+        all_hits_impl(ray, answer, scratch);
+        return answer.size() > before;
+    }
 }
 
 template <class Set>
@@ -712,8 +702,8 @@ bool RayClassification<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch
 }
 
 template <class Set>
-void RayClassification<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                                      QueryScratch& scratch) const {
+void RayClassification<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits,
+                                           QueryScratch& scratch) const {
     if (set_ == nullptr || !is_valid(ray)) return;
     TraversalCounters unused;
     const Search search = find_candidates(ray, unused);
@@ -790,5 +780,8 @@ AcceleratorStats RayClassification<Set>::stats() const {
 template class RayClassification<TriangleSet<float>>;
 template class RayClassification<TriangleSet<double>>;
 template class RayClassification<ShapeSet>;
+template class AcceleratorBase<RayClassification<TriangleSet<float>>, TriangleSet<float>>;
+template class AcceleratorBase<RayClassification<TriangleSet<double>>, TriangleSet<double>>;
+template class AcceleratorBase<RayClassification<ShapeSet>, ShapeSet>;
 
 }  // namespace csgrt

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "accelerator_base.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
@@ -192,27 +193,18 @@ std::span<const std::uint32_t> RegularGrid<Set>::cell_primitives(int x, int y, i
 }
 
 template <class Set>
-bool RegularGrid<Set>::intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return intersect_impl<false>(ray, record, scratch, unused);
-}
-
-template <class Set>
-bool RegularGrid<Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
-    TraversalCounters unused;
-    return occluded_impl<false>(ray, scratch, unused);
-}
-
-template <class Set>
-bool RegularGrid<Set>::intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                                         TraversalCounters& counters) const {
-    return intersect_impl<true>(ray, record, scratch, counters);
-}
-
-template <class Set>
-bool RegularGrid<Set>::occluded_counted(const Ray& ray, QueryScratch& scratch,
-                                        TraversalCounters& counters) const {
-    return occluded_impl<true>(ray, scratch, counters);
+template <QueryKind kKind, bool kCounted>
+bool RegularGrid<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+                             TraversalCounters& counters) const {
+    if constexpr (kKind == QueryKind::kNearest) {
+        return intersect_impl<kCounted>(ray, answer, scratch, counters);
+    } else if constexpr (kKind == QueryKind::kAny) {
+        return occluded_impl<kCounted>(ray, scratch, counters);
+    } else {
+        const std::size_t before = answer.size();
+        all_hits_impl(ray, answer, scratch);
+        return answer.size() > before;
+    }
 }
 
 template <class Set>
@@ -298,8 +290,8 @@ bool RegularGrid<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
 }
 
 template <class Set>
-void RegularGrid<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                                QueryScratch& scratch) const {
+void RegularGrid<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits,
+                                     QueryScratch& scratch) const {
     if (set_ == nullptr || !is_valid(ray)) return;
     const auto prepared = set_->prepare(ray, scratch);
     const std::size_t first = hits.size();
@@ -332,5 +324,8 @@ void RegularGrid<Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
 template class RegularGrid<TriangleSet<float>>;
 template class RegularGrid<TriangleSet<double>>;
 template class RegularGrid<ShapeSet>;
+template class AcceleratorBase<RegularGrid<TriangleSet<float>>, TriangleSet<float>>;
+template class AcceleratorBase<RegularGrid<TriangleSet<double>>, TriangleSet<double>>;
+template class AcceleratorBase<RegularGrid<ShapeSet>, ShapeSet>;
 
 }  // namespace csgrt

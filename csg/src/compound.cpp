@@ -24,100 +24,52 @@ bool is_bounded(const Aabb& box) {
     return box.is_finite();
 }
 
-}  // namespace
-
-std::string choose_accelerator(std::size_t count, std::string& reason) {
-    if (count <= kHandfulOfMembers) {
-        reason = std::to_string(count) + " bounded member" + (count == 1 ? "" : "s") +
-                 " (at most " + std::to_string(kHandfulOfMembers) +
-                 "): tested directly, no hierarchy";
-        return "brute";
+std::vector<std::shared_ptr<const Shape>> checked_children(
+    std::vector<std::shared_ptr<const Shape>> children) {
+    for (std::size_t i = 0; i < children.size(); ++i) {
+        require(children[i] != nullptr, "Compound", "child " + std::to_string(i), "a shape",
+                "null");
     }
-    const auto names = accelerator_names();
-    if (std::find(names.begin(), names.end(), "bvh") != names.end()) {
-        reason = std::to_string(count) + " bounded members: a BVH over their boxes";
-        return "bvh";
-    }
-    reason = std::to_string(count) +
-             " bounded members: brute force, because this build has no BVH (\"bvh\" is not "
-             "registered with make_accelerator)";
-    return "brute";
+    return children;
 }
 
+}  // namespace
+
 Compound::Compound(std::vector<std::shared_ptr<const Shape>> children, const CompoundConfig& config)
-    : children_(std::move(children)) {
-    std::vector<std::shared_ptr<const Shape>> bounded;
+    : children_(checked_children(std::move(children))),
+      group_(children_, config.accelerator, config.accelerator_config) {
     solid_ = !children_.empty();
-    for (std::size_t i = 0; i < children_.size(); ++i) {
-        const auto& child = children_[i];
-        require(child != nullptr, "Compound", "child " + std::to_string(i), "a shape", "null");
+    for (const auto& child : children_) {
         solid_ = solid_ && child->is_solid();
-        const Aabb box = child->bounds();
-        bounds_.extend(box);
-        // A child with an empty box can never be hit; it is neither tested nor bounded.
-        if (box.is_empty()) continue;
-        if (is_bounded(box)) {
-            bounded.push_back(child);
-            set_child_.push_back(static_cast<std::uint32_t>(i));
-        } else {
-            unbounded_.push_back(static_cast<std::uint32_t>(i));
-        }
+        bounds_.extend(child->bounds());
     }
-    set_ = ShapeSet(std::move(bounded));
-    std::string name = config.accelerator;
-    if (name == "auto") {
-        name = choose_accelerator(set_.size(), accelerator_reason_);
-    } else {
-        accelerator_reason_ = "requested";
-    }
-    if (set_.size() > 0) structure_ = make_accelerator(name, set_, config.accelerator_config);
 }
 
 std::string_view Compound::accelerator_name() const {
-    return structure_ ? structure_->name() : std::string_view();
+    return group_.bounded().size() > 0 ? group_.accelerator_name() : std::string_view();
 }
 
 AcceleratorStats Compound::accelerator_stats() const {
-    return structure_ ? structure_->stats() : AcceleratorStats{};
+    return group_.bounded().size() > 0 ? group_.accelerator_stats() : AcceleratorStats{};
 }
 
 bool Compound::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    if (unbounded_.empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
-    HitRecord best;
-    bool found = structure_ && structure_->intersect(ray, best, scratch);
-    if (found) best.object = set_child_[best.object];
-    for (const std::uint32_t index : unbounded_) {
-        Ray narrowed = ray;
-        if (found) narrowed.t_max = best.t;
-        HitRecord candidate;
-        if (!children_[index]->nearest_hit(narrowed, candidate, scratch)) continue;
-        // Children are visited in index order only within each group, so ties are decided here.
-        if (found && !(candidate.t < best.t || (candidate.t == best.t && index < best.object)))
-            continue;
-        best = candidate;
-        best.object = index;
-        found = true;
-    }
-    if (found) record = best;
-    return found;
+    if (group_.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
+    return group_.nearest(ray, record, scratch);
 }
 
 bool Compound::any_hit(const Ray& ray, QueryScratch& scratch) const {
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    if (unbounded_.empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
-    if (structure_ && structure_->occluded(ray, scratch)) return true;
-    for (const std::uint32_t index : unbounded_) {
-        if (children_[index]->any_hit(ray, scratch)) return true;
-    }
-    return false;
+    if (group_.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
+    return group_.any(ray, scratch);
 }
 
 void Compound::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
     spans.clear();
     if (!solid_) return;
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    if (unbounded_.empty() && !box_hit(bounds_, ray, inverse_direction)) return;
+    if (group_.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return;
     union_of_spans(ray, spans, scratch);
 }
 
@@ -127,23 +79,23 @@ void Compound::union_of_spans(const Ray& ray, SpanList& spans, QueryScratch& scr
     BorrowedHits candidates(scratch);
     std::vector<HitRecord>& list = candidates.list();
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    if (set_.size() <= kLinearSpanChildren) {
-        for (std::size_t i = 0; i < set_.size(); ++i) {
-            if (box_hit(set_.bounds(i), ray, inverse_direction)) {
-                list.push_back(HitRecord{.object = set_child_[i]});
+    const ShapeSet& bounded = group_.bounded();
+    if (bounded.size() <= kLinearSpanChildren) {
+        for (std::size_t i = 0; i < bounded.size(); ++i) {
+            if (box_hit(bounded.bounds(i), ray, inverse_direction)) {
+                list.push_back(HitRecord{.object = group_.member_of(i)});
             }
         }
-    } else if (structure_) {
+    } else {
         // A child whose spans overlap [t_min, t_max] enters at some finite t <= t_max, so its
         // line has a crossing in [-inf, t_max]; the structure finds those children without
         // visiting the others. (A child that wholly contains [t_min, t_max] has no crossing
         // inside it, which is why the interval is not used as it is.)
         Ray line = ray;
         line.t_min = -kInfinity;
-        structure_->all_hits(line, list, scratch);
-        for (HitRecord& hit : list) hit.object = set_child_[hit.object];
+        group_.all_bounded(line, list, scratch);
     }
-    for (const std::uint32_t index : unbounded_) list.push_back(HitRecord{.object = index});
+    for (const std::uint32_t index : group_.unbounded()) list.push_back(HitRecord{.object = index});
     std::sort(list.begin(), list.end(),
               [](const HitRecord& a, const HitRecord& b) { return a.object < b.object; });
 

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "csgrt/core/hit.h"
@@ -68,6 +69,53 @@ public:
                           QueryScratch& scratch) const = 0;
 
     virtual AcceleratorStats stats() const = 0;
+};
+
+/// What one structure query answers: the nearest hit (intersect), whether anything is hit
+/// (occluded), or every hit (all_hits).
+enum class QueryKind { kNearest, kAny, kAll };
+
+/// Where a query of kind kKind writes its answer: the nearest hit's record, nothing, or the
+/// list the hits are appended to.
+struct NoAnswer {};
+template <QueryKind kKind>
+using QueryAnswer = std::conditional_t<
+    kKind == QueryKind::kNearest, HitRecord,
+    std::conditional_t<kKind == QueryKind::kAll, std::vector<HitRecord>, NoAnswer>>;
+
+/// The Accelerator overrides written once (CRTP). A structure derives from
+/// AcceleratorBase<Structure, Set>, names itself in `static constexpr std::string_view kName`,
+/// fills `stats_` in its build, and answers every query in one member template
+///
+///     template <QueryKind kKind, bool kCounted>
+///     bool query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+///                TraversalCounters& counters) const;
+///
+/// returning whether anything was found (for kNearest writing `answer` only then). The counted
+/// and uncounted queries are separate instances, so the uncounted traversal pays nothing for
+/// counting. The overrides are defined in accel/src/accelerator_base.h, which the structure's
+/// source includes and instantiates with `template class AcceleratorBase<Structure<S>, S>;`
+/// next to its query, so no other file needs to see the query.
+template <class Derived, class Set>
+class AcceleratorBase : public Accelerator<Set> {
+public:
+    std::string_view name() const final;
+    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const final;
+    bool occluded(const Ray& ray, QueryScratch& scratch) const final;
+    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
+                           TraversalCounters& counters) const final;
+    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
+                          TraversalCounters& counters) const final;
+    void all_hits(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const final;
+    /// The figures the structure's build wrote into stats_ (a structure whose figures grow
+    /// after the build overrides this).
+    AcceleratorStats stats() const override;
+
+protected:
+    AcceleratorStats stats_;
+
+private:
+    const Derived& derived() const { return static_cast<const Derived&>(*this); }
 };
 
 }  // namespace csgrt

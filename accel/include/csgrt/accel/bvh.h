@@ -34,7 +34,7 @@ struct BvhTraversal;
 /// the leaves hold their triangles four to a block (BvhConfig::triangle_blocks), tested with
 /// SIMD lane by lane in exactly the set's float arithmetic, so the answers stay the set's own.
 template <class Set>
-class Bvh final : public Accelerator<Set> {
+class Bvh final : public AcceleratorBase<Bvh<Set>, Set> {
 public:
     /// Relative padding of primitive boxes and relative widening of slab intervals (2^-18,
     /// 64 float ulps: far above the few ulps the analysis needs, and too small to matter).
@@ -44,16 +44,11 @@ public:
     /// Throws InvalidParameter for a config outside the ranges documented in BvhConfig.
     void build(const Set& set, const BvhConfig& config = {});
 
-    std::string_view name() const override { return "bvh"; }
-    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
-    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                           TraversalCounters& counters) const override;
-    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
-                          TraversalCounters& counters) const override;
-    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                  QueryScratch& scratch) const override;
-    AcceleratorStats stats() const override { return stats_; }
+    static constexpr std::string_view kName = "bvh";
+    /// Every query (the Accelerator overrides come from AcceleratorBase).
+    template <QueryKind kKind, bool kCounted>
+    bool query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+               TraversalCounters& counters) const;
 
     /// The binary nodes (width 2), the 4- or 8-wide nodes (width 4 or 8; each empty for the
     /// other widths), and the leaves' contents: primitive indices in leaf order, or triangle
@@ -77,6 +72,7 @@ public:
 
 private:
     friend struct detail::BvhTraversal<Set>;
+    using AcceleratorBase<Bvh<Set>, Set>::stats_;
 
     /// Copies the triangles of each leaf of `tree` into blocks_, in leaf order, and points
     /// the leaves at their first block (TriangleSet<float> only).
@@ -90,7 +86,6 @@ private:
     WideBvhNodes<8> nodes_8_;
     std::vector<std::uint32_t> indices_;
     std::vector<BvhTriangleBlock, AlignedAllocator<BvhTriangleBlock>> blocks_;
-    AcceleratorStats stats_;
 };
 
 class ShapeSet;

@@ -7,36 +7,10 @@
 #include <utility>
 #include <vector>
 
+#include "csgrt/accel/accelerator_config.h"
+
 namespace csgrt {
 
-/// How a Bvh is built and laid out. The SAH costs are relative: only their ratio matters.
-struct BvhConfig {
-    /// Bins per axis of the binned SAH (Wald 2007); 16 to 32 is the usual trade-off between
-    /// build time and tree quality. Must be in [2, 256].
-    int bins = 16;
-    /// A node with more primitives than this is always split (if its centroids differ); a
-    /// smaller one becomes a leaf when the SAH says splitting does not pay. Must be >= 1.
-    int max_leaf_size = 8;
-    /// SAH cost of visiting a node (testing its children's boxes). Must be > 0.
-    double traversal_cost = 1.0;
-    /// SAH cost of one primitive test. Must be > 0.
-    double intersection_cost = 1.0;
-    /// 8 or 4: the binary tree is collapsed into 8- or 4-wide nodes whose boxes are tested
-    /// four (SSE) or eight (AVX2, see `avx2`) at a time (8, the default, measured about 10% faster
-    /// than 4 on the armadillo); 2: the binary tree is traversed as built.
-    int width = 8;
-    /// Build large subtrees on several threads (oneTBB); the tree is the same either way.
-    bool parallel = true;
-    /// For TriangleSet<float> sets: the BVH keeps its own copy of each leaf's triangles, four
-    /// to a block in leaf order (BvhTriangleBlock), and tests a block's four at once with SIMD,
-    /// as Embree's Triangle4 leaves do; the SAH then prices a leaf by its blocks. Ignored for
-    /// other sets, whose leaves name their primitives and test them one at a time.
-    bool triangle_blocks = true;
-    /// Test 8-wide nodes with AVX2 (one 8-lane slab test) when the CPU has it, as `build`
-    /// checks. The AVX2 and SSE code do the same float operations lane by lane, so answers and
-    /// counters are the same either way; false forces the SSE code.
-    bool avx2 = true;
-};
 
 /// A binary BVH node in 32 bytes: a float box and either two children, stored side by side
 /// at `offset` and `offset + 1` (count == 0), or a leaf of `count` primitives that are

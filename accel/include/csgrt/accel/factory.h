@@ -1,26 +1,15 @@
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include "csgrt/accel/accelerator.h"
-#include "csgrt/accel/brute_force.h"
-#include "csgrt/accel/bvh.h"
-#include "csgrt/accel/hierarchical_grid.h"
-#include "csgrt/accel/ray_classification.h"
-#include "csgrt/accel/regular_grid.h"
+#include "csgrt/accel/accelerator_config.h"
 
 namespace csgrt {
-
-/// The configuration of every structure, so one value can be handed to the factory.
-struct AcceleratorConfig {
-    BruteForceConfig brute_force;
-    GridConfig grid;
-    HierarchicalGridConfig hierarchical_grid;
-    RayClassificationConfig ray_classification;
-    BvhConfig bvh;
-};
 
 /// The names `make_accelerator` accepts, in the order the benchmark reports them.
 std::span<const std::string_view> accelerator_names();
@@ -31,5 +20,14 @@ std::span<const std::string_view> accelerator_names();
 template <class Set>
 std::unique_ptr<Accelerator<Set>> make_accelerator(std::string_view name, const Set& set,
                                                    const AcceleratorConfig& config = {});
+
+/// At most this many bounded members are tested directly under "auto".
+inline constexpr std::size_t kHandfulOfMembers = 4;
+
+/// The structure "auto" picks for `count` bounded members (a compound's children, a scene's
+/// objects): "brute" for at most kHandfulOfMembers (testing a handful directly costs less than
+/// traversing a hierarchy over them), otherwise "bvh" when the factory knows it, else "brute".
+/// `reason` receives one sentence saying which rule applied (docs/scene.md).
+std::string choose_accelerator(std::size_t count, std::string& reason);
 
 }  // namespace csgrt

@@ -5,26 +5,10 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/accel/regular_grid.h"
 
 namespace csgrt {
-
-struct HierarchicalGridConfig {
-    /// The top grid has about N^top_cells_exponent cells for N primitives. Ize, Shirley and
-    /// Parker, "Grid Creation Strategies for Efficient Ray Tracing", 2007, derive N^0.6 for
-    /// one level of nesting (N^(3 / (3 + 2 d)) for d levels). In [0, 1].
-    double top_cells_exponent = 0.6;
-    /// Cells listing more than this many primitives are considered for a sub-grid (>= 1).
-    int max_primitives_per_cell = 16;
-    /// Density of each sub-grid, in cells per primitive of the cell it refines (> 0).
-    double sub_cells_per_primitive = 2.0;
-    /// Most levels of sub-grids below the top grid, in [0, 8] (0: a plain grid).
-    int max_depth = 3;
-    /// Most cells along one axis of any one grid (>= 1).
-    int max_resolution = 128;
-    /// As GridConfig::triangle_box_test, at every level.
-    bool triangle_box_test = true;
-};
 
 /// A hierarchy of uniform grids after Jevans & Wyvill, "Adaptive Voxel Subdivision for Ray
 /// Tracing", Graphics Interface 1989: a coarse top grid (N^0.6 cells, Ize et al. 2007) whose
@@ -40,20 +24,15 @@ struct HierarchicalGridConfig {
 /// every level, descending into sub-grids, with one mailbox and one stopping rule for the whole
 /// ray.
 template <class Set>
-class HierarchicalGrid final : public Accelerator<Set> {
+class HierarchicalGrid final : public AcceleratorBase<HierarchicalGrid<Set>, Set> {
 public:
     void build(const Set& set, const HierarchicalGridConfig& config = {});
 
-    std::string_view name() const override { return "hgrid"; }
-    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
-    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                           TraversalCounters& counters) const override;
-    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
-                          TraversalCounters& counters) const override;
-    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                  QueryScratch& scratch) const override;
-    AcceleratorStats stats() const override { return stats_; }
+    static constexpr std::string_view kName = "hgrid";
+    /// Every query (the Accelerator overrides come from AcceleratorBase).
+    template <QueryKind kKind, bool kCounted>
+    bool query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+               TraversalCounters& counters) const;
 
     /// Number of grids (the top grid is grid 0).
     std::size_t grid_count() const { return grids_.size(); }
@@ -93,6 +72,8 @@ private:
                         TraversalCounters& counters) const;
     template <bool kCount>
     bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
+    using AcceleratorBase<HierarchicalGrid<Set>, Set>::stats_;
 
     const Set* set_ = nullptr;
     HierarchicalGridConfig config_;
@@ -102,7 +83,6 @@ private:
     std::vector<Cell> cells_;
     std::vector<std::uint32_t> primitives_;
     std::vector<std::uint32_t> unbounded_;
-    AcceleratorStats stats_;
 };
 
 class ShapeSet;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/accel/factory.h"
 #include "csgrt/accel/mesh_io.h"
 #include "csgrt/accel/triangle_set.h"

@@ -12,45 +12,11 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/accel/bvh_build.h"
 #include "csgrt/core/aabb.h"
 
 namespace csgrt {
-
-/// How a ray-space cell picks the axis it is halved along.
-enum class RayClassificationSplit {
-    /// x, y, z, u, v in turn, by depth (Arvo & Kirk's order).
-    kCycle,
-    /// The axis whose halving narrows the cell's beam the most: the beam's width across the
-    /// rays is estimated from the origin extents, the origin extent along the face axis seen
-    /// at the rays' slope, and the direction extents times how far the rays can still travel
-    /// through the scene (docs/structures.md).
-    kNarrowBeam,
-};
-
-struct RayClassificationConfig {
-    /// A leaf that a ray reaches is split while its candidates hold more primitives than this.
-    std::uint32_t max_leaf_candidates = 16;
-    /// The deepest a face's tree may grow (halvings from its root), at most 60; 0 chooses
-    /// round(2.4 log2 n) for n primitives (38 for 50k), about where a cell's beam narrows to
-    /// the size of one primitive of an evenly tessellated surface.
-    int max_depth = 0;
-    /// Cap on the bytes of all candidate lists and cells, the six roots included. Once it is
-    /// reached cells stop splitting, and a new cell whose list would not fit searches its
-    /// parent's list; stats() reports how often either happened. Answers stay exact whatever
-    /// the cap (0: the six root cells only).
-    std::size_t max_candidate_bytes = std::size_t{256} << 20;
-    RayClassificationSplit split = RayClassificationSplit::kNarrowBeam;
-    /// A leaf is split only once this many queries have searched it, so a cell that few
-    /// incoherent rays reach is searched, not refined for nobody (>= 1; 1: at the first).
-    std::uint32_t visits_before_split = 64;
-    /// A candidate cluster is replaced by its two halves while it is wider across the rays
-    /// than this many times the cell's beam (> 0): smaller values give longer, tighter lists.
-    double cluster_width = 2.0;
-    /// Subdivide every cell with more than max_leaf_candidates primitives down to this depth
-    /// during build(), before any ray arrives (0: purely lazy).
-    int build_depth = 0;
-};
 
 namespace detail {
 
@@ -147,7 +113,7 @@ inline bool beam_may_hit(const RayCell& cell, const Aabb& box) {
 /// Hypercubes are split lazily, when rays reach them; lazy splitting is thread-safe, and once
 /// a path is built queries take no lock (docs/structures.md).
 template <class Set>
-class RayClassification final : public Accelerator<Set> {
+class RayClassification final : public AcceleratorBase<RayClassification<Set>, Set> {
 public:
     RayClassification();
     ~RayClassification() override;
@@ -162,15 +128,11 @@ public:
     /// lazy build apart from the queries. Safe alongside queries.
     void prebuild(std::span<const Ray> rays);
 
-    std::string_view name() const override { return "rayclass"; }
-    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
-    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                           TraversalCounters& counters) const override;
-    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
-                          TraversalCounters& counters) const override;
-    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                  QueryScratch& scratch) const override;
+    static constexpr std::string_view kName = "rayclass";
+    /// Every query (the Accelerator overrides come from AcceleratorBase).
+    template <QueryKind kKind, bool kCounted>
+    bool query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+               TraversalCounters& counters) const;
     /// The current figures: they grow as rays split cells.
     AcceleratorStats stats() const override;
 
@@ -231,6 +193,7 @@ private:
                         TraversalCounters& counters) const;
     template <bool kCount>
     bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
 
     const Set* set_ = nullptr;
     RayClassificationConfig config_;

@@ -6,25 +6,10 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/core/aabb.h"
 
 namespace csgrt {
-
-struct GridConfig {
-    /// Target number of cells per primitive (the grid density): the cell edge is
-    /// a = cbrt(V / (cells_per_primitive N)) for N primitives in a box of volume V, so the grid
-    /// has about cells_per_primitive N cells. The literature writes a = cbrt(lambda V / N), with
-    /// lambda = 1 / cells_per_primitive; Ize et al. 2007 show Theta(N) cells is right for
-    /// well-shaped meshes. Must be > 0.
-    double cells_per_primitive = 8.0;
-    /// Most cells along one axis (the clamp of the per-axis counts), >= 1. Keeps memory bounded
-    /// for very elongated or very large scenes.
-    int max_resolution = 256;
-    /// For triangle sets: reference a triangle only from the cells the triangle itself
-    /// overlaps (Akenine-Moeller, "Fast 3D Triangle-Box Overlap Testing", JGT 2001), not from
-    /// every cell of its bounding box. Long, thin, diagonal triangles touch far fewer cells.
-    bool triangle_box_test = true;
-};
 
 namespace detail {
 
@@ -77,20 +62,15 @@ GridGeometry choose_grid_geometry(const Aabb& bounds, std::size_t count, double 
 /// skips most repeated tests of primitives that span several cells and keeps queries
 /// thread-safe. Primitives with unbounded or empty boxes are tested by every ray.
 template <class Set>
-class RegularGrid final : public Accelerator<Set> {
+class RegularGrid final : public AcceleratorBase<RegularGrid<Set>, Set> {
 public:
     void build(const Set& set, const GridConfig& config = {});
 
-    std::string_view name() const override { return "grid"; }
-    bool intersect(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool occluded(const Ray& ray, QueryScratch& scratch) const override;
-    bool intersect_counted(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                           TraversalCounters& counters) const override;
-    bool occluded_counted(const Ray& ray, QueryScratch& scratch,
-                          TraversalCounters& counters) const override;
-    void all_hits(const Ray& ray, std::vector<HitRecord>& hits,
-                  QueryScratch& scratch) const override;
-    AcceleratorStats stats() const override { return stats_; }
+    static constexpr std::string_view kName = "grid";
+    /// Every query (the Accelerator overrides come from AcceleratorBase).
+    template <QueryKind kKind, bool kCounted>
+    bool query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+               TraversalCounters& counters) const;
 
     /// The grid's cells (box, resolution, cell size), for tests and reports.
     const detail::GridGeometry& geometry() const { return geometry_; }
@@ -111,6 +91,8 @@ private:
                         TraversalCounters& counters) const;
     template <bool kCount>
     bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
+    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
+    using AcceleratorBase<RegularGrid<Set>, Set>::stats_;
     bool is_occupied(std::size_t cell) const { return (occupied_[cell / 64] >> (cell % 64)) & 1; }
 
     const Set* set_ = nullptr;
@@ -128,7 +110,6 @@ private:
     /// cell: the walk jumps over the empty cells around a cell in one step.
     std::vector<std::uint8_t> empty_radius_;
     std::vector<std::uint32_t> unbounded_;
-    AcceleratorStats stats_;
 };
 
 class ShapeSet;

@@ -8,34 +8,26 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/accel/shape_set.h"
 #include "csgrt/core/shape.h"
+#include "csgrt/csg/shape_group.h"
 
 namespace csgrt {
 
-/// The structure "auto" picks for `count` bounded members (a compound's children, a scene's
-/// objects): "brute" for at most kHandfulOfMembers (testing a handful directly costs less than
-/// traversing a hierarchy over them), otherwise "bvh" when the factory knows it, else "brute".
-/// `reason` receives one sentence saying which rule applied.
-std::string choose_accelerator(std::size_t count, std::string& reason);
-
-/// At most this many bounded members are tested directly under "auto".
-inline constexpr std::size_t kHandfulOfMembers = 4;
-
 /// How a Compound organises its children.
 struct CompoundConfig {
-    /// "auto" (choose_accelerator) or a name make_accelerator knows.
+    /// "auto" (choose_accelerator, accel/factory.h) or a name make_accelerator knows.
     std::string accelerator = "auto";
     AcceleratorConfig accelerator_config;
 };
 
 /// A plain group of shapes (Suffern, "Ray Tracing from the Ground Up", 2007, ch. 19): the
-/// nearest hit among the children, no boolean. The bounded children sit in an acceleration
-/// structure built through make_accelerator (accel/factory.h); unbounded ones (planes) are kept
-/// apart and asked on every ray. A compound is itself a shape with a box, so compounds of
-/// compounds form a hierarchy of bounding boxes: a ray that misses a compound's box costs one
-/// box test, whatever is inside.
+/// nearest hit among the children, no boolean. The children form a ShapeGroup (csg/shape_group.h):
+/// the bounded ones sit in an acceleration structure built through make_accelerator; unbounded
+/// ones (planes) are kept apart and asked on every ray. A compound is itself a shape with a box, so
+/// compounds of compounds form a hierarchy of bounding boxes: a ray that misses a compound's box
+/// costs one box test, whatever is inside.
 ///
 /// Hits carry `object` = the index of the child they belong to (an enclosing set overwrites it
 /// with its own member index); at equal t the lower child index wins.
@@ -73,7 +65,7 @@ public:
     /// The structure over the bounded children ("" when there are none), why it was chosen,
     /// and its figures.
     std::string_view accelerator_name() const;
-    const std::string& accelerator_reason() const { return accelerator_reason_; }
+    const std::string& accelerator_reason() const { return group_.accelerator_reason(); }
     AcceleratorStats accelerator_stats() const;
 
 private:
@@ -82,15 +74,10 @@ private:
     void union_of_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const;
 
     std::vector<std::shared_ptr<const Shape>> children_;
-    /// The bounded children, in child order, and the child index of each set member.
-    ShapeSet set_;
-    std::vector<std::uint32_t> set_child_;
-    std::unique_ptr<Accelerator<ShapeSet>> structure_;
-    /// Children with an infinite box, by child index.
-    std::vector<std::uint32_t> unbounded_;
+    /// The children as a group (member index = child index).
+    ShapeGroup group_;
     Aabb bounds_;
     bool solid_ = false;
-    std::string accelerator_reason_;
 };
 
 /// Groups `shapes` into a tree of nested compounds of at most `max_children` children each,

@@ -8,11 +8,14 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/accelerator_config.h"
 #include "csgrt/accel/factory.h"
 #include "csgrt/core/shape.h"
 #include "csgrt/csg/camera.h"
 
 namespace csgrt {
+
+class ShapeGroup;
 
 /// A Lambertian surface colour (linear RGB albedo in [0, 1]).
 struct Material {
@@ -82,9 +85,10 @@ public:
     void set_camera(Camera camera);
 
     /// Builds everything queries need: validates the camera, computes the bounds, and builds
-    /// the structure over the bounded objects ("auto": choose_accelerator in csg/compound.h,
-    /// documented in docs/scene.md). Throws InvalidParameter for an invalid camera or an
-    /// unknown structure name; the scene is then left uncommitted.
+    /// the objects' ShapeGroup (csg/shape_group.h), a structure over the bounded objects
+    /// ("auto": choose_accelerator in accel/factory.h, documented in docs/scene.md). Throws
+    /// InvalidParameter for an invalid camera or an unknown structure name; the scene is then left
+    /// uncommitted.
     void commit(const SceneConfig& config = {});
     bool is_committed() const { return committed_; }
 
@@ -108,9 +112,11 @@ public:
     std::string_view accelerator_name() const;
     const std::string& accelerator_reason() const { return accelerator_reason_; }
     AcceleratorStats accelerator_stats() const;
+    /// The committed objects as a group (member index = object index), for queries built on
+    /// the scene's structure; null before commit.
+    const ShapeGroup* group() const;
 
 private:
-    struct Committed;
     std::vector<SceneObject> objects_;
     std::vector<Material> materials_;
     std::vector<Light> lights_;
@@ -118,7 +124,8 @@ private:
     Aabb bounds_;
     bool committed_ = false;
     std::string accelerator_reason_;
-    std::shared_ptr<const Committed> committed_state_;
+    /// Held by shared_ptr so a Scene stays cheap to copy (copies share the built structure).
+    std::shared_ptr<const ShapeGroup> group_;
 };
 
 }  // namespace csgrt
