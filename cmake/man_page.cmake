@@ -1,6 +1,7 @@
 # Writes the csgrt man page with help2man from the program's own help (run at build time by
 # cmake/install.cmake): `csgrt --help` and `--version` for NAME, SYNOPSIS and OPTIONS, and each
 # subcommand's --help as a section of its own, so the page says what the program says.
+cmake_minimum_required(VERSION 3.25)
 foreach(variable PROGRAM HELP2MAN OUTPUT)
     if(NOT DEFINED ${variable})
         message(FATAL_ERROR "man_page.cmake: ${variable} is not set")

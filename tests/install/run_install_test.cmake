@@ -6,6 +6,7 @@
 # first configures and builds the libraries and the program from SOURCE_DIR into BUILD_DIR with
 # BUILD_SHARED_LIBS=ON, and checks each library's SONAME and that it exports csgrt's symbols
 # only. Fails on the first step that fails, with that step's output.
+cmake_minimum_required(VERSION 3.25)
 foreach(variable BUILD_DIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
     if(NOT DEFINED ${variable})
         message(FATAL_ERROR "run_install_test.cmake: ${variable} is not set")
