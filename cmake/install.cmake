@@ -1,74 +1,135 @@
-# Install rules and the CMake package: `cmake --install` puts the headers of all four layers,
-# their static libraries, the csgrt program and a package config into the prefix, so another
-# project can find_package(csgrt) and link csgrt::csgrt.
+# Install rules: `cmake --install` puts the four libraries (static, or shared with
+# BUILD_SHARED_LIBS=ON), their headers, a CMake package with one component per library, a
+# pkg-config file per library, the csgrt program with its man page, and the docs into the
+# prefix. The CGAL reference and the command-line library are not installed.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(CSGRT_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/csgrt)
-set(CSGRT_LIBRARIES csgrt_core csgrt_accel csgrt_csg csgrt_render)
+set(CSGRT_INSTALL_COMPONENTS core accel csg render)
 
-# The umbrella target a consumer links: every layer and, through them, every dependency.
-add_library(csgrt_package INTERFACE)
-target_link_libraries(csgrt_package INTERFACE ${CSGRT_LIBRARIES})
-set_target_properties(csgrt_package PROPERTIES EXPORT_NAME csgrt)
-foreach(library IN LISTS CSGRT_LIBRARIES)
-    string(REPLACE "csgrt_" "" short_name ${library})
-    set_target_properties(${library} PROPERTIES EXPORT_NAME ${short_name})
-endforeach()
-# The static libraries name these two interface targets in their link interface.
-set_target_properties(csgrt_options PROPERTIES EXPORT_NAME options)
-set_target_properties(csgrt_warnings PROPERTIES EXPORT_NAME warnings)
-
-install(TARGETS ${CSGRT_LIBRARIES} csgrt_package csgrt_options csgrt_warnings
-    EXPORT csgrtTargets
-    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
-    INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-foreach(layer core accel csg render)
-    install(DIRECTORY ${PROJECT_SOURCE_DIR}/${layer}/include/
-        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-endforeach()
-if(TARGET csgrt)
-    install(TARGETS csgrt RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-endif()
-install(EXPORT csgrtTargets NAMESPACE csgrt:: DESTINATION ${CSGRT_INSTALL_CMAKEDIR})
-
-# find_dependency calls for every package our libraries link, public or private (static
-# libraries carry their private dependencies to the final link). Each entry maps a prefix of
-# the imported target names to the find_package arguments that provide it; a dependency that
-# is added to a layer and missing here makes the install test fail at the consumer's configure.
-# OpenMesh is asked for its CONFIG package: CGAL's config puts a FindOpenMesh.cmake module on
-# the path that does not find Debian's OpenMesh.
+# Which packages a component's consumer must find: the public dependencies, and for static
+# libraries the private ones too (they reach the final link). Each entry maps a prefix of the
+# imported target names to the find_package arguments and the pkg-config module that provide
+# it. A dependency that is added to a library and missing here stops the configure, so the
+# package can never forget one. Header-only private dependencies are linked inside
+# $<BUILD_INTERFACE:...> by their library and so never appear here.
 set(CSGRT_KNOWN_DEPENDENCIES
-    "Eigen3::|Eigen3 3.4 NO_MODULE"
-    "Threads::|Threads"
-    "CGAL::|CGAL"
-    "TBB::|TBB"
-    "OpenEXR::|OpenEXR 3"
-    "PNG::|PNG"
-    "CLI11::|CLI11"
-    "nlohmann_json::|nlohmann_json"
-    "OpenMesh|OpenMesh CONFIG"
-    "embree|embree 3")
-set(CSGRT_FIND_DEPENDENCIES "")
-set(linked "")
-foreach(library IN LISTS CSGRT_LIBRARIES)
-    get_target_property(libraries ${library} LINK_LIBRARIES)
-    if(libraries)
-        list(APPEND linked ${libraries})
-    endif()
-endforeach()
-foreach(entry IN LISTS CSGRT_KNOWN_DEPENDENCIES)
-    string(REPLACE "|" ";" parts "${entry}")
-    list(GET parts 0 prefix)
-    list(GET parts 1 arguments)
-    foreach(name IN LISTS linked)
-        string(FIND "${name}" "${prefix}" position)
-        if(position EQUAL 0)
-            string(APPEND CSGRT_FIND_DEPENDENCIES "find_dependency(${arguments})\n")
-            break()
+    "Eigen3::|Eigen3 3.4 NO_MODULE|eigen3"
+    "TBB::|TBB|tbb"
+    "OpenEXR::|OpenEXR 3|OpenEXR"
+    "PNG::|PNG|libpng"
+    "OpenMesh|OpenMesh CONFIG|openmesh")
+
+# csgrt_component_dependencies(<component> <find_out> <public_pc_out> <private_pc_out>)
+function(csgrt_component_dependencies component find_out public_pc_out private_pc_out)
+    set(target csgrt_${component})
+    get_target_property(public ${target} INTERFACE_LINK_LIBRARIES)
+    get_target_property(all ${target} LINK_LIBRARIES)
+    get_target_property(type ${target} TYPE)
+    set(find_text "")
+    set(public_pc "")
+    set(private_pc "")
+    foreach(name IN LISTS all)
+        if(name MATCHES "^\\$<BUILD_INTERFACE:" OR name MATCHES "^csgrt")
+            continue()  # build settings, header-only dependencies, csgrt's own layers
+        endif()
+        set(known FALSE)
+        foreach(entry IN LISTS CSGRT_KNOWN_DEPENDENCIES)
+            string(REPLACE "|" ";" parts "${entry}")
+            list(GET parts 0 prefix)
+            list(GET parts 1 arguments)
+            list(GET parts 2 module)
+            string(FIND "${name}" "${prefix}" position)
+            if(NOT position EQUAL 0)
+                continue()
+            endif()
+            set(known TRUE)
+            set(is_public FALSE)
+            if(name IN_LIST public)
+                set(is_public TRUE)
+            endif()
+            if(is_public OR type STREQUAL "STATIC_LIBRARY")
+                string(FIND "${find_text}" "find_dependency(${arguments})" seen)
+                if(seen EQUAL -1)
+                    string(APPEND find_text "    find_dependency(${arguments})\n")
+                endif()
+            endif()
+            # pkg-config: static libraries need every dependency at the consumer's link.
+            if(is_public OR type STREQUAL "STATIC_LIBRARY")
+                list(APPEND public_pc ${module})
+            else()
+                list(APPEND private_pc ${module})
+            endif()
+        endforeach()
+        if(NOT known)
+            message(FATAL_ERROR "cmake/install.cmake: csgrt_${component} links ${name}, which "
+                "CSGRT_KNOWN_DEPENDENCIES does not list")
         endif()
     endforeach()
+    list(REMOVE_DUPLICATES public_pc)
+    list(REMOVE_DUPLICATES private_pc)
+    set(${find_out} "${find_text}" PARENT_SCOPE)
+    set(${public_pc_out} "${public_pc}" PARENT_SCOPE)
+    set(${private_pc_out} "${private_pc}" PARENT_SCOPE)
+endfunction()
+
+# Every layer below a component, as pkg-config modules (csgrt-core, ...).
+set(CSGRT_LAYERS_BELOW_core "")
+set(CSGRT_LAYERS_BELOW_accel "csgrt-core")
+set(CSGRT_LAYERS_BELOW_csg "csgrt-accel")
+set(CSGRT_LAYERS_BELOW_render "csgrt-csg")
+
+file(RELATIVE_PATH CSGRT_PC_PREFIX_FROM_PCFILEDIR
+    /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
+set(CSGRT_COMPONENT_DEPENDENCIES "")
+foreach(component IN LISTS CSGRT_INSTALL_COMPONENTS)
+    install(TARGETS csgrt_${component} EXPORT csgrt_${component}_targets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+    install(EXPORT csgrt_${component}_targets NAMESPACE csgrt::
+        FILE csgrt_${component}_targets.cmake DESTINATION ${CSGRT_INSTALL_CMAKEDIR})
+    # The command line's header belongs to the program (render/CMakeLists.txt).
+    install(DIRECTORY ${PROJECT_SOURCE_DIR}/${component}/include/
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+        PATTERN command_line.h EXCLUDE)
+
+    csgrt_component_dependencies(${component} find_text public_pc private_pc)
+    string(APPEND CSGRT_COMPONENT_DEPENDENCIES
+        "if(\"${component}\" IN_LIST _csgrt_load)\n${find_text}endif()\n")
+
+    set(CSGRT_PC_NAME csgrt-${component})
+    set(CSGRT_PC_DESCRIPTION "csgrt's ${component} library")
+    list(JOIN public_pc " " CSGRT_PC_REQUIRES)
+    string(PREPEND CSGRT_PC_REQUIRES "${CSGRT_LAYERS_BELOW_${component}} ")
+    string(STRIP "${CSGRT_PC_REQUIRES}" CSGRT_PC_REQUIRES)
+    list(JOIN private_pc " " CSGRT_PC_REQUIRES_PRIVATE)
+    set(CSGRT_PC_LIBS "-L\${libdir} -lcsgrt_${component}")
+    set(CSGRT_PC_CFLAGS "-I\${includedir}")
+    configure_file(${PROJECT_SOURCE_DIR}/cmake/csgrt.pc.in
+        ${PROJECT_BINARY_DIR}/pkgconfig/csgrt-${component}.pc @ONLY)
+    install(FILES ${PROJECT_BINARY_DIR}/pkgconfig/csgrt-${component}.pc
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 endforeach()
+# csgrt.pc: every library, as csgrt::csgrt.
+set(CSGRT_PC_NAME csgrt)
+set(CSGRT_PC_DESCRIPTION "${PROJECT_DESCRIPTION}")
+set(CSGRT_PC_REQUIRES "csgrt-render")
+set(CSGRT_PC_REQUIRES_PRIVATE "")
+set(CSGRT_PC_LIBS "")
+set(CSGRT_PC_CFLAGS "")
+configure_file(${PROJECT_SOURCE_DIR}/cmake/csgrt.pc.in ${PROJECT_BINARY_DIR}/pkgconfig/csgrt.pc
+    @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/pkgconfig/csgrt.pc
+    DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# csgrt::csgrt, loaded with the render component (which brings every layer).
+set_target_properties(csgrt_package PROPERTIES EXPORT_NAME csgrt)
+install(TARGETS csgrt_package EXPORT csgrt_targets)
+install(EXPORT csgrt_targets NAMESPACE csgrt:: FILE csgrt_targets.cmake
+    DESTINATION ${CSGRT_INSTALL_CMAKEDIR})
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/csgrtConfig.cmake.in
     ${PROJECT_BINARY_DIR}/csgrtConfig.cmake
@@ -78,17 +139,53 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/csgrtConfigVersion.cmake
 install(FILES ${PROJECT_BINARY_DIR}/csgrtConfig.cmake ${PROJECT_BINARY_DIR}/csgrtConfigVersion.cmake
     DESTINATION ${CSGRT_INSTALL_CMAKEDIR})
 
-# The install test (label "install"): installs this build into a temporary prefix, then
-# configures, builds and runs a small consumer project against it.
+# The program, its man page (help2man, from the program's own --help: cmake/man_page.cmake),
+# the docs and the example scenes under share/doc/csgrt.
+if(TARGET csgrt)
+    install(TARGETS csgrt RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+    find_program(CSGRT_HELP2MAN help2man)
+    if(CSGRT_HELP2MAN)
+        add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/man/csgrt.1
+            COMMAND ${CMAKE_COMMAND} -D PROGRAM=$<TARGET_FILE:csgrt> -D HELP2MAN=${CSGRT_HELP2MAN}
+                -D OUTPUT=${PROJECT_BINARY_DIR}/man/csgrt.1
+                -P ${PROJECT_SOURCE_DIR}/cmake/man_page.cmake
+            DEPENDS csgrt ${PROJECT_SOURCE_DIR}/cmake/man_page.cmake
+            COMMENT "help2man: csgrt.1")
+        add_custom_target(csgrt_man_page ALL DEPENDS ${PROJECT_BINARY_DIR}/man/csgrt.1)
+        install(FILES ${PROJECT_BINARY_DIR}/man/csgrt.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+    else()
+        message(STATUS "help2man not found: no man page (scripts/bootstrap installs it)")
+    endif()
+endif()
+install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/LICENSE
+    DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR}
+    FILES_MATCHING PATTERN "*.md" PATTERN "*.json")
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/scenes/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples)
+
+# The install tests (label "install"): each stages an install under a temporary prefix, then
+# builds and runs one consumer project per component against that prefix only
+# (tests/install/run_install_test.cmake). install.consumer_project installs this build;
+# install.shared_libraries configures and builds the libraries with BUILD_SHARED_LIBS=ON in
+# a tree of its own first, then does the same.
 if(CSGRT_BUILD_TESTS)
+    set(CSGRT_INSTALL_TEST_ARGUMENTS
+        -D CONSUMER_SOURCE_DIR=${PROJECT_SOURCE_DIR}/tests/install/consumer
+        -D GENERATOR=${CMAKE_GENERATOR}
+        -D CXX_COMPILER=${CMAKE_CXX_COMPILER}
+        -D BUILD_TYPE=${CMAKE_BUILD_TYPE})
     add_test(NAME install.consumer_project
-        COMMAND ${CMAKE_COMMAND}
+        COMMAND ${CMAKE_COMMAND} ${CSGRT_INSTALL_TEST_ARGUMENTS}
             -D BUILD_DIR=${PROJECT_BINARY_DIR}
-            -D CONSUMER_SOURCE_DIR=${PROJECT_SOURCE_DIR}/tests/install/consumer
             -D WORK_DIR=${PROJECT_BINARY_DIR}/install_test
-            -D GENERATOR=${CMAKE_GENERATOR}
-            -D CXX_COMPILER=${CMAKE_CXX_COMPILER}
-            -D BUILD_TYPE=${CMAKE_BUILD_TYPE}
             -P ${PROJECT_SOURCE_DIR}/tests/install/run_install_test.cmake)
     set_tests_properties(install.consumer_project PROPERTIES LABELS install TIMEOUT 600)
+    add_test(NAME install.shared_libraries
+        COMMAND ${CMAKE_COMMAND} ${CSGRT_INSTALL_TEST_ARGUMENTS}
+            -D SOURCE_DIR=${PROJECT_SOURCE_DIR}
+            -D BUILD_DIR=${PROJECT_BINARY_DIR}/install_test_shared/libraries
+            -D WORK_DIR=${PROJECT_BINARY_DIR}/install_test_shared
+            -D SHARED=ON
+            -P ${PROJECT_SOURCE_DIR}/tests/install/run_install_test.cmake)
+    set_tests_properties(install.shared_libraries PROPERTIES LABELS install TIMEOUT 1200)
 endif()

@@ -6,10 +6,13 @@
 // (--benchmark_filter, --benchmark_format=json, --benchmark_out=...), plus the options below.
 #include <benchmark/benchmark.h>
 
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -32,9 +35,45 @@ constexpr const char* kUsage = R"(csgrt_bench [--quick | --full] [options] [Goog
   --full           every real mesh, generated meshes up to 13.3M triangles, 1024x1024
   --report DIR     also write DIR/report.md and DIR/report.json (plots: scripts/plot_benchmarks.py)
   --commit HASH    the commit named in the report
-  --threads N      the "all threads" count (default: the hardware threads)
-  --data DIR       the repository's data/ folder (default: the source tree's)
+  --threads N      the "all threads" count, 1..1024 (default: the hardware threads)
+  --data DIR       the repository's data/ folder (default: the first data/ holding scenes/
+                   in the folders above this program, so a build tree inside the source
+                   tree finds it)
+
+--quick and --full exclude each other. --benchmark_list_tests prints only the benchmarks'
+names. Ray throughput is Google Benchmark's items_per_second (rays per second).
 )";
+
+constexpr int kMaxThreads = 1024;
+
+/// The data/ folder of the repository this program was built in: the first folder called
+/// data with a scenes/ inside, in the program's folder or one above it. Empty when none is.
+std::filesystem::path find_data_folder() {
+    std::error_code error;
+    const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
+    if (error) return {};
+    for (std::filesystem::path folder = program.parent_path(); !folder.empty();
+         folder = folder.parent_path()) {
+        if (std::filesystem::is_directory(folder / "data" / "scenes", error)) {
+            return folder / "data";
+        }
+        if (folder == folder.parent_path()) break;
+    }
+    return {};
+}
+
+/// --threads' value: a whole number in [1, kMaxThreads], or an error saying so.
+int parse_threads(const std::string& text) {
+    int threads = 0;
+    const char* end = text.data() + text.size();
+    const auto [last, status] = std::from_chars(text.data(), end, threads);
+    if (text.empty() || status != std::errc() || last != end || threads < 1 ||
+        threads > kMaxThreads) {
+        throw std::invalid_argument("--threads wants a whole number from 1 to " +
+                                    std::to_string(kMaxThreads) + ", got '" + text + "'");
+    }
+    return threads;
+}
 
 struct Options {
     Settings settings;
@@ -47,8 +86,8 @@ struct Options {
 Options parse_options(int& argc, char** argv) {
     Options options;
     options.settings.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-    options.settings.data = std::filesystem::path(CSGRT_SOURCE_DIR) / "data";
     std::string mode = "standard";
+    bool data_given = false;
     int kept = 1;
     for (int i = 1; i < argc; ++i) {
         const std::string argument = argv[i];
@@ -60,10 +99,12 @@ Options parse_options(int& argc, char** argv) {
         auto is = [&](const std::string& flag) {
             return argument == flag || argument.rfind(flag + "=", 0) == 0;
         };
-        if (argument == "--quick") {
-            mode = "quick";
-        } else if (argument == "--full") {
-            mode = "full";
+        if (argument == "--quick" || argument == "--full") {
+            const std::string chosen = argument.substr(2);
+            if (mode != "standard" && mode != chosen) {
+                throw std::invalid_argument("--quick and --full exclude each other");
+            }
+            mode = chosen;
         } else if (argument == "--help" || argument == "-h") {
             options.help = true;
         } else if (is("--report")) {
@@ -71,14 +112,23 @@ Options parse_options(int& argc, char** argv) {
         } else if (is("--commit")) {
             options.commit = value("--commit");
         } else if (is("--threads")) {
-            options.settings.threads = std::max(1, std::stoi(value("--threads")));
+            options.settings.threads = parse_threads(value("--threads"));
         } else if (is("--data")) {
             options.settings.data = value("--data");
+            data_given = true;
         } else {
             argv[kept++] = argv[i];
         }
     }
     argc = kept;
+    if (!data_given) options.settings.data = find_data_folder();
+    if (options.settings.data.empty()) {
+        throw std::invalid_argument(
+            "cannot find the data/ folder above this program; give it with --data DIR");
+    }
+    if (!std::filesystem::is_directory(options.settings.data)) {
+        throw std::invalid_argument("--data " + options.settings.data.string() + ": not a folder");
+    }
     Settings& settings = options.settings;
     settings.mode = mode;
     if (mode == "quick") {
@@ -203,6 +253,18 @@ int main(int argc, char** argv) {
     if (!has_flag(argc, argv, "--benchmark_min_time")) arguments.push_back(min_time.data());
     // Initialize removes the flags it knows, so what the output format is must be read first.
     const bool format_given = has_flag(argc, argv, "--benchmark_format");
+    // --benchmark_list_tests: the names and nothing else on stdout.
+    const bool list_only = has_flag(argc, argv, "--benchmark_list_tests") &&
+                           !has_flag(argc, argv, "--benchmark_list_tests=false") &&
+                           !has_flag(argc, argv, "--benchmark_list_tests=0");
+    // --benchmark_out's reporter, made here so it too reports items_per_second; the library
+    // opens the file and points the reporter at it.
+    std::string out_format = "json";
+    for (int i = 1; i < argc; ++i) {
+        const char* flag = "--benchmark_out_format=";
+        if (std::strncmp(argv[i], flag, std::strlen(flag)) == 0)
+            out_format = argv[i] + std::strlen(flag);
+    }
     const bool machine_readable = has_flag(argc, argv, "--benchmark_format=json") ||
                                   has_flag(argc, argv, "--benchmark_format=csv");
     int count = static_cast<int>(arguments.size());
@@ -229,6 +291,11 @@ int main(int argc, char** argv) {
     csgrt::bench::Workloads workloads(settings.sizes);
     register_all(workloads, settings);
 
+    if (list_only) {
+        benchmark::RunSpecifiedBenchmarks();
+        benchmark::Shutdown();
+        return 0;
+    }
     const bool compact = settings.mode == "quick" && !format_given;
     csgrt::bench::CollectingReporter reporter(compact ? csgrt::bench::make_compact_reporter()
                                                       : benchmark::CreateDefaultDisplayReporter());
@@ -236,7 +303,17 @@ int main(int argc, char** argv) {
         std::printf("csgrt_bench --quick on %s (%d hardware threads), load average %s\n",
                     context.machine.c_str(), context.cores, context.load_before.c_str());
     }
-    benchmark::RunSpecifiedBenchmarks(&reporter);
+    std::unique_ptr<benchmark::BenchmarkReporter> file_reporter;
+    // (The deprecated CSV format is left to the library's own reporter.)
+    if (has_flag(argc, argv, "--benchmark_out=") && out_format != "csv") {
+        benchmark::BenchmarkReporter* inner =
+            out_format == "console"
+                ? static_cast<benchmark::BenchmarkReporter*>(
+                      new benchmark::ConsoleReporter(benchmark::ConsoleReporter::OO_None))
+                : new benchmark::JSONReporter();
+        file_reporter = std::make_unique<csgrt::bench::ThroughputReporter>(inner);
+    }
+    benchmark::RunSpecifiedBenchmarks(&reporter, file_reporter.get());
     benchmark::Shutdown();
     context.load_after = csgrt::bench::load_average();
 

@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "csgrt/accel/cgal_reference.h"
+#include "csgrt/reference/cgal_reference.h"
 #include "csgrt/accel/triangle_set.h"
 #include "tracer.h"
 

@@ -42,8 +42,38 @@ bool CollectingReporter::ReportContext(const Context& context) {
     return display_->ReportContext(context);
 }
 
+std::vector<benchmark::BenchmarkReporter::Run> with_items_per_second(
+    const std::vector<benchmark::BenchmarkReporter::Run>& runs) {
+    std::vector<benchmark::BenchmarkReporter::Run> converted = runs;
+    for (auto& run : converted) {
+        const auto rays = run.counters.find("rays");
+        if (rays == run.counters.end()) continue;
+        run.counters["items_per_second"] =
+            benchmark::Counter(rays->second.value, benchmark::Counter::kIsRate);
+        run.counters.erase("rays");
+    }
+    return converted;
+}
+
+ThroughputReporter::ThroughputReporter(benchmark::BenchmarkReporter* inner) : inner_(inner) {}
+
+bool ThroughputReporter::ReportContext(const Context& context) {
+    // The library points this reporter at the --benchmark_out file; the inner one writes there.
+    inner_->SetOutputStream(&GetOutputStream());
+    inner_->SetErrorStream(&GetErrorStream());
+    return inner_->ReportContext(context);
+}
+
+void ThroughputReporter::ReportRuns(const std::vector<Run>& runs) {
+    inner_->ReportRuns(with_items_per_second(runs));
+}
+
+void ThroughputReporter::Finalize() {
+    inner_->Finalize();
+}
+
 void CollectingReporter::ReportRuns(const std::vector<Run>& runs) {
-    display_->ReportRuns(runs);
+    display_->ReportRuns(with_items_per_second(runs));
     for (const Run& run : runs) {
         // Repetitions: keep the median aggregate if there is one, else the last run.
         const bool aggregate = run.run_type == Run::RT_Aggregate;
@@ -95,7 +125,7 @@ public:
                 out << ": " << run.error_message << "\n";
                 continue;
             }
-            const auto rays = run.counters.find("rays");
+            const auto rays = run.counters.find("items_per_second");
             if (run.run_name.function_name.rfind("csg/", 0) == 0) {
                 char text[64];
                 std::snprintf(text, sizeof text, " %10.3g ms/frame", run.GetAdjustedRealTime());

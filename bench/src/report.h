@@ -65,6 +65,26 @@ private:
     std::vector<Result> results_;
 };
 
+/// `runs` with each ray rate (the benchmarks' "rays" counter, already per second) reported as
+/// Google Benchmark's own throughput field, items_per_second, which tools that read its
+/// console and JSON output know. The Results keep the name "rays".
+std::vector<benchmark::BenchmarkReporter::Run> with_items_per_second(
+    const std::vector<benchmark::BenchmarkReporter::Run>& runs);
+
+/// Forwards everything to `inner` (for --benchmark_out: the file reporter) with the ray rates
+/// as items_per_second.
+class ThroughputReporter final : public benchmark::BenchmarkReporter {
+public:
+    explicit ThroughputReporter(benchmark::BenchmarkReporter* inner);
+
+    bool ReportContext(const Context& context) override;
+    void ReportRuns(const std::vector<Run>& runs) override;
+    void Finalize() override;
+
+private:
+    std::unique_ptr<benchmark::BenchmarkReporter> inner_;
+};
+
 /// A one-line-per-benchmark display for --quick: the name and its Mrays/s (Google
 /// Benchmark's own table, with every counter, is what the other modes show).
 benchmark::BenchmarkReporter* make_compact_reporter();

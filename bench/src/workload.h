@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
-#include "csgrt/accel/cgal_reference.h"
+#include "csgrt/reference/cgal_reference.h"
 #include "csgrt/accel/mesh_io.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/bench/ray_sets.h"

@@ -19,10 +19,12 @@
 #include <mutex>
 #include <new>
 #include <optional>
+#include <nlohmann/json.hpp>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "csgrt/accel/mesh.h"
 #include "csgrt/core/error.h"
@@ -42,6 +44,10 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+/// The exit status of a usage error (a bad option or argument, a missing file), as getopt-style
+/// programs and CLI11's own parse errors use it; 1 is kept for a scene or render that fails.
+constexpr int kUsageErrorStatus = 2;
+
 /// A mistake in the command line; its message is the error line.
 class UsageError : public std::runtime_error {
 public:
@@ -60,32 +66,6 @@ std::string available_structures() {
     std::string list = "auto";
     for (std::string_view name : accelerator_names()) list.append(", ").append(name);
     return list;
-}
-
-void check_structure(const std::string& name) {
-    if (name == "auto") return;
-    const auto names = accelerator_names();
-    if (std::find(names.begin(), names.end(), name) != names.end()) return;
-    throw UsageError("--accel " + name +
-                     ": unknown structure (available: " + available_structures() + ")");
-}
-
-void check_range(const char* option, long long value, long long low, long long high) {
-    if (value < low || value > high) {
-        throw UsageError(std::string(option) + " must be in [" + std::to_string(low) + ", " +
-                         std::to_string(high) + "], got " + std::to_string(value));
-    }
-}
-
-void check_scene_path(const fs::path& path) {
-    std::error_code error;
-    if (!fs::exists(path, error)) {
-        throw UsageError("scene file '" + path.string() + "' does not exist");
-    }
-    if (fs::is_directory(path, error)) {
-        throw UsageError("scene file '" + path.string() + "' is a directory");
-    }
-    // FIFOs, devices and sizes: load_scene refuses them with the reason.
 }
 
 /// Fails early, before any work, for an output the writer could not produce or that would
@@ -137,8 +117,8 @@ std::uint64_t memory_available(std::uint64_t configured) {
     return std::uint64_t(pages) * std::uint64_t(page_size);
 }
 
+/// The scene file exists and is not a directory: its option's CLI::ExistingFile said so.
 Scene load_checked(const std::string& scene_path) {
-    check_scene_path(scene_path);
     return load_scene(scene_path);  // SceneError messages name the file and the place
 }
 
@@ -198,6 +178,7 @@ struct RenderOptions {
     double exposure_stops = 0.0;
     bool timing_in_header = false;
     bool statistics = false;
+    bool json = false;
 };
 
 double seconds_since(Clock::time_point start) {
@@ -252,12 +233,15 @@ void print_statistics(std::ostream& out, const Scene& scene, const RenderStats& 
     }
 }
 
+/// {"x": .., "y": .., "z": ..} of a point or vector, for --json. (Its text is dumped with
+/// invalid UTF-8 replaced, so a file name in any encoding prints.)
+nlohmann::json json_of(const Vector3& v) {
+    return {{"x", v.x()}, {"y", v.y()}, {"z", v.z()}};
+}
+
 void render_command(const RenderOptions& options, CommandLineStreams streams) {
-    check_range("--width", options.width, 1, kMaxImageSize);
-    check_range("--height", options.height, 1, kMaxImageSize);
-    check_range("--spp", options.samples_per_pixel, 1, kMaxSamplesPerPixel);
-    check_range("--threads", options.threads, 0, 1024);
-    check_structure(options.accelerator);
+    // --width, --height, --spp, --threads, --accel and the scene were checked by their
+    // options' CLI11 validators.
     ToneMapping tone_mapping;
     try {
         tone_mapping.curve = parse_tone_curve(options.tone_curve);
@@ -326,6 +310,27 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
     stage_seconds[2] = result.stats.seconds;
     stage_seconds[3] = seconds_since(stage_start);
 
+    if (options.json) {
+        const nlohmann::json summary = {
+            {"scene", options.scene},
+            {"width", options.width},
+            {"height", options.height},
+            {"samples_per_pixel", options.samples_per_pixel},
+            {"seconds", result.stats.seconds},
+            {"million_rays_per_second", result.stats.million_rays_per_second()},
+            {"primary_rays", result.stats.primary_rays},
+            {"shadow_rays", result.stats.shadow_rays},
+            {"structure",
+             {{"name", metadata.accelerator},
+              {"objects", scene.objects().size()},
+              {"build_milliseconds", structure.build_milliseconds}}},
+            {"outputs",
+             {output.string(), colour_preview_path(output).string(),
+              cost_preview_path(output).string()}}};
+        streams.out << summary.dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+                    << '\n';
+        return;
+    }
     std::ostringstream summary;
     summary.setf(std::ios::fixed);
     summary.precision(3);
@@ -349,7 +354,45 @@ std::string describe(const Vector3& v) {
     return text.str();
 }
 
-void info_command(const std::string& scene_path, CommandLineStreams streams) {
+/// `csgrt info --json`: what the text report says, as one JSON object (docs/rendering.md).
+void print_info_json(const std::string& scene_path, const Scene& scene,
+                     const std::map<std::string, std::uint64_t>& counts, std::uint64_t shapes,
+                     std::size_t unbounded, std::uint64_t triangles, std::ostream& out) {
+    std::size_t point_lights = 0;
+    for (const Light& light : scene.lights())
+        point_lights += std::holds_alternative<PointLight>(light);
+    const Camera& camera = scene.camera();
+    const bool pinhole = camera.projection == Camera::Projection::Pinhole;
+    nlohmann::json camera_json = {{"projection", pinhole ? "pinhole" : "orthographic"},
+                                  {"position", json_of(camera.position)},
+                                  {"look_at", json_of(camera.look_at)}};
+    if (pinhole) {
+        camera_json["vertical_fov_degrees"] = camera.vertical_fov_degrees;
+    } else {
+        camera_json["orthographic_height"] = camera.orthographic_height;
+    }
+    const Aabb& bounds = scene.bounds();
+    const nlohmann::json info = {
+        {"scene", scene_path},
+        {"objects",
+         {{"top_level", scene.objects().size()}, {"unbounded", unbounded}, {"shapes", shapes}}},
+        {"kinds", counts},
+        {"triangles", triangles},
+        {"materials", scene.materials().size()},
+        {"lights",
+         {{"total", scene.lights().size()},
+          {"point", point_lights},
+          {"directional", scene.lights().size() - point_lights}}},
+        {"camera", camera_json},
+        {"bounds", bounds.is_empty() ? nlohmann::json(nullptr)
+                                     : nlohmann::json{{"lower", json_of(bounds.lower)},
+                                                      {"upper", json_of(bounds.upper)}}},
+        {"structure",
+         {{"name", scene.accelerator_name()}, {"reason", scene.accelerator_reason()}}}};
+    out << info.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
+}
+
+void info_command(const std::string& scene_path, bool json, CommandLineStreams streams) {
     Scene scene = load_checked(scene_path);
     scene.commit();  // "auto": what a render without --accel would build
     // Memoised per distinct shape: a 2^64-leaf expansion costs what was loaded, not 2^64.
@@ -357,6 +400,11 @@ void info_command(const std::string& scene_path, CommandLineStreams streams) {
     std::size_t unbounded = 0;
     for (const SceneObject& object : scene.objects()) {
         if (!object.shape->bounds().is_finite()) ++unbounded;
+    }
+    if (json) {
+        print_info_json(scene_path, scene, counts.by_kind, counts.shapes, unbounded,
+                        counts.triangles, streams.out);
+        return;
     }
     std::ostream& out = streams.out;
     out << "scene:      " << scene_path << '\n';
@@ -482,7 +530,12 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
         "  csgrt validate my_scene.json\n"
         "\n"
         "Run 'csgrt SUBCOMMAND --help' for a subcommand's options. Exit status: 0 on success, 1 "
-        "on any error (one line on stderr).");
+        "when a scene cannot be loaded or a render fails, 2 for a usage error (bad option, "
+        "missing file); every error is one line on stderr.\n"
+        "\n"
+        "Documentation: 'man csgrt', and " CSGRT_DOC_DIR
+        " (README.md, rendering.md,\n"
+        "scene-format.md, the JSON Schema scene.schema.json, example scenes in examples/).");
 
     RenderOptions options;
     CLI::App* render = app.add_subcommand("render", "Render a scene to an EXR with PNG previews");
@@ -492,33 +545,36 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
         "(structure nodes visited plus primitives tested) in its part \"rgba\", and id (uint\n"
         "object index; 4294967295 for background, named by the idManifest) in its part \"id\";\n"
         "beside it OUT.png (colour, tone mapped by --tonemap, sRGB) and OUT.cost.png (cost in\n"
-        "false colour, with a scale). Prints one summary line: time, Mrays/s, the structure;\n"
-        "--stats adds a table of rays, hits, the structure's work and time per stage.");
+        "false colour, with a scale). Prints one summary line: time, Mrays/s, the structure (with\n"
+        "--json, one JSON object instead); --stats adds a table of rays, hits, the structure's work and time per stage.");
     render->add_option("scene", options.scene, "The JSON scene file")
         ->required()
+        ->check(CLI::ExistingFile)
         ->type_name("SCENE.json");
     render->add_option("-o,--output", options.output, "The EXR file to write")
         ->required()
         ->type_name("OUT.exr");
-    render
-        ->add_option("--width", options.width,
-                     "Image width in pixels, 1.." + std::to_string(kMaxImageSize))
+    render->add_option("--width", options.width, "Image width in pixels")
+        ->check(CLI::Range(1, kMaxImageSize))
         ->capture_default_str();
-    render
-        ->add_option("--height", options.height,
-                     "Image height in pixels, 1.." + std::to_string(kMaxImageSize))
+    render->add_option("--height", options.height, "Image height in pixels")
+        ->check(CLI::Range(1, kMaxImageSize))
         ->capture_default_str();
     render
         ->add_option("--spp", options.samples_per_pixel,
-                     "Samples per pixel on a stratified jittered grid, 1.." +
-                         std::to_string(kMaxSamplesPerPixel))
+                     "Samples per pixel on a stratified jittered grid")
+        ->check(CLI::Range(1, kMaxSamplesPerPixel))
         ->capture_default_str();
     render->add_option("--threads", options.threads, "Worker threads; 0 uses every core")
+        ->check(CLI::Range(0, 1024))
         ->capture_default_str();
+    std::vector<std::string> structures = {"auto"};
+    for (std::string_view name : accelerator_names()) structures.emplace_back(name);
     render
         ->add_option("--accel", options.accelerator,
                      "The structure over the scene's objects: " + available_structures() +
                          " ('csgrt info' shows what auto picks)")
+        ->check(CLI::IsMember(structures))
         ->capture_default_str()
         ->type_name("NAME");
     render
@@ -538,8 +594,10 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
     render->add_flag("--stats", options.statistics,
                      "Print a statistics table after the summary: rays by kind, hits by shape "
                      "kind, the structure's work, time per stage");
+    render->add_flag("--json", options.json, "Print the summary as one JSON object");
 
     std::string scene_path;
+    bool info_json = false;
     CLI::App* info = app.add_subcommand("info", "Describe a scene and the structure 'auto' builds");
     info->footer(
         "Counts every shape by kind through the whole tree (instances, booleans, compounds;\n"
@@ -547,14 +605,17 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
         "and the structure 'auto' picks for the top-level objects, with the reason.");
     info->add_option("scene", scene_path, "The JSON scene file")
         ->required()
+        ->check(CLI::ExistingFile)
         ->type_name("SCENE.json");
+    info->add_flag("--json", info_json, "Print the description as one JSON object");
     CLI::App* validate =
-        app.add_subcommand("validate", "Check a scene file (errors only, exit 0 or 1)");
+        app.add_subcommand("validate", "Check a scene file (errors only; exit 0 when usable)");
     validate->footer(
         "Loads and commits the scene. Prints nothing and exits 0 when it is usable; otherwise\n"
         "prints the first error (file, place in the file, what was expected) and exits 1.");
     validate->add_option("scene", scene_path, "The JSON scene file")
         ->required()
+        ->check(CLI::ExistingFile)
         ->type_name("SCENE.json");
 
     try {
@@ -575,11 +636,15 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
         if (render->parsed()) {
             render_command(options, streams);
         } else if (info->parsed()) {
-            info_command(scene_path, streams);
+            info_command(scene_path, info_json, streams);
         } else {
             validate_command(scene_path);
         }
         return 0;
+    } catch (const UsageError& error) {
+        streams.out.flush();
+        streams.err << "csgrt: error: " << one_line(error.what()) << std::endl;
+        return kUsageErrorStatus;
     } catch (const std::exception& error) {
         streams.out.flush();
         streams.err << "csgrt: error: " << one_line(error.what()) << std::endl;

@@ -1,4 +1,4 @@
-#include "csgrt/accel/cgal_reference.h"
+#include "csgrt/reference/cgal_reference.h"
 
 #include <gtest/gtest.h>
 

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "csgrt/accel/brute_force.h"
-#include "csgrt/accel/cgal_reference.h"
+#include "csgrt/reference/cgal_reference.h"
 #include "csgrt/accel/factory.h"
 #include "csgrt/accel/mesh_io.h"
 #include "csgrt/accel/shape_set.h"

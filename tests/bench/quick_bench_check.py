@@ -63,7 +63,7 @@ for rays in ("camera", "incoherent"):
         # Aimed at points of the mesh's box, which is the cube: every ray hits it.
         check(fractions.get("bvh", 0) == 1.0, "incoherent: every ray hits the cube")
     for variant, b in traced.items():
-        check(b["rays"] > 0, f"{variant}/{rays} has a ray rate")
+        check(b.get("items_per_second", 0) > 0, f"{variant}/{rays} has a ray rate (items_per_second)")
 
 for scene in ("part_objects", "showcase"):
     # Manual time adds "/manual_time" to the names.

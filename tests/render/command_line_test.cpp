@@ -72,10 +72,11 @@ ProgramRun run(std::vector<std::string> arguments) {
     return {status, out.str(), err.str()};
 }
 
-/// An error run: exit status 1, nothing on stdout, exactly one line on stderr that starts
-/// with "csgrt: error: " and contains `fragment`.
-void expect_one_line_error(const ProgramRun& result, const std::string& fragment) {
-    EXPECT_EQ(result.status, 1);
+/// An error run: exit status `status` (1: the scene or the render failed; 2: a usage error),
+/// nothing on stdout, exactly one line on stderr that starts with "csgrt: error: " and
+/// contains `fragment`.
+void expect_one_line_error(const ProgramRun& result, const std::string& fragment, int status = 1) {
+    EXPECT_EQ(result.status, status);
     EXPECT_EQ(result.out, "");
     ASSERT_FALSE(result.err.empty());
     EXPECT_EQ(result.err.rfind("csgrt: error: ", 0), 0u) << result.err;
@@ -162,20 +163,23 @@ TEST_F(CommandLine, BadArgumentsGiveOneLineAndNoFiles) {
         {{"draw", scene_}, "draw"},
         {{"render", scene_}, "--output is required"},
         {{"render", "-o", output_}, "scene is required"},
-        {{"render", scene_, "-o", output_, "--width", "0"}, "--width must be in [1, 16384]"},
-        {{"render", scene_, "-o", output_, "--height", "16385"}, "--height must be in"},
+        {{"render", scene_, "-o", output_, "--width", "0"},
+         "--width: Value 0 not in range 1 to 16384"},
+        {{"render", scene_, "-o", output_, "--height", "16385"},
+         "--height: Value 16385 not in range 1 to 16384"},
         {{"render", scene_, "-o", output_, "--width", "-7"}, "--width"},
         {{"render", scene_, "-o", output_, "--width", "abc"}, "--width"},
         {{"render", scene_, "-o", output_, "--width", "99999999999"}, "--width"},
-        {{"render", scene_, "-o", output_, "--spp", "0"}, "--spp must be in [1, 4096]"},
-        {{"render", scene_, "-o", output_, "--spp", "4097"}, "--spp must be in [1, 4096]"},
+        {{"render", scene_, "-o", output_, "--spp", "0"}, "--spp: Value 0 not in range 1 to 4096"},
+        {{"render", scene_, "-o", output_, "--spp", "4097"},
+         "--spp: Value 4097 not in range 1 to 4096"},
         {{"render", scene_, "-o", output_, "--threads", "-1"}, "--threads"},
-        {{"render", scene_, "-o", output_, "--accel", "octree"}, "unknown structure"},
+        {{"render", scene_, "-o", output_, "--accel", "octree"}, "octree not in {auto,"},
         {{"render", scene_, "-o", output_, "--bogus"}, "--bogus"},
         {{"render", scene_, "-o", output_, "--tonemap", "aces"}, "--tonemap aces: unknown curve"},
         {{"render", scene_, "-o", output_, "--exposure", "100"}, "--exposure must be in"},
         {{"render", (directory_ / "missing.json").string(), "-o", output_}, "missing.json"},
-        {{"render", directory_.string(), "-o", output_}, "is a directory"},
+        {{"render", directory_.string(), "-o", output_}, "is actually a directory"},
         {{"render", scene_, "-o", (directory_ / "no" / "out.exr").string()}, "does not exist"},
         {{"render", scene_, "-o", (directory_ / "out.png").string()}, "must end in .exr"},
         {{"info"}, "scene is required"},
@@ -183,7 +187,7 @@ TEST_F(CommandLine, BadArgumentsGiveOneLineAndNoFiles) {
     };
     for (const auto& [arguments, fragment] : cases) {
         SCOPED_TRACE(::testing::PrintToString(arguments));
-        expect_one_line_error(run(arguments), fragment);
+        expect_one_line_error(run(arguments), fragment, 2);
     }
     expect_no_output();
 }
@@ -239,7 +243,7 @@ TEST_F(CommandLine, ABrokenSceneFileIsOneLineNamingTheFileAndWritesNothing) {
 
 TEST_F(CommandLine, AnOutputThatIsADirectoryIsRefusedBeforeRendering) {
     fs::create_directory(directory_ / "out.png");
-    expect_one_line_error(run({"render", scene_, "-o", output_}), "is a directory");
+    expect_one_line_error(run({"render", scene_, "-o", output_}), "is a directory", 2);
     EXPECT_EQ(names_in(directory_), (std::vector<std::string>{"out.png", "scene.json"}));
 }
 
@@ -423,7 +427,7 @@ TEST_F(CommandLine, HelpAndVersionSucceed) {
     EXPECT_EQ(version.out.rfind("csgrt ", 0), 0u);
 }
 
-TEST_F(CommandLine, TheProgramExitsWithStatusOneOnBadInput) {
+TEST_F(CommandLine, TheProgramExitsWithStatusTwoOnUsageErrorsAndOneOnABrokenScene) {
     // The real binary, not the in-process entry point: exit statuses as a shell sees them.
     const fs::path program = fs::path(CSGRT_BINARY_DIR) / "render" / "csgrt";
     ASSERT_TRUE(fs::exists(program)) << program << " is built with the tests";
@@ -434,11 +438,15 @@ TEST_F(CommandLine, TheProgramExitsWithStatusOneOnBadInput) {
         fs::remove(directory_ / "stderr.txt");
         return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
     };
-    EXPECT_EQ(status_of("render " + scene_ + " -o " + output_ + " --width 0"), 1);
-    EXPECT_EQ(status_of("render " + scene_ + " -o " + output_ + " --accel nope"), 1);
-    EXPECT_EQ(status_of("validate " + (directory_ / "none.json").string()), 1);
-    EXPECT_EQ(status_of(""), 1);
+    EXPECT_EQ(status_of("render " + scene_ + " -o " + output_ + " --width 0"), 2);
+    EXPECT_EQ(status_of("render " + scene_ + " -o " + output_ + " --accel nope"), 2);
+    EXPECT_EQ(status_of("validate " + (directory_ / "none.json").string()), 2);
+    EXPECT_EQ(status_of(""), 2);
     expect_no_output();
+    const std::string broken = (directory_ / "broken.json").string();
+    std::ofstream(broken) << R"({"objects": [{"type": "sphere", "radius": -1}]})";
+    EXPECT_EQ(status_of("validate " + broken), 1);
+    fs::remove(broken);
     EXPECT_EQ(status_of("validate " + scene_), 0);
     EXPECT_EQ(status_of("--help"), 0);
     EXPECT_EQ(status_of("render " + scene_ + " -o " + output_ + " --width 8 --height 8"), 0);

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "csgrt/accel/cgal_reference.h"
+#include "csgrt/reference/cgal_reference.h"
 #include "csgrt/accel/factory.h"
 #include "csgrt/accel/mesh_io.h"
 #include "csgrt/accel/mesh_tools.h"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
-#include "csgrt/accel/cgal_reference.h"
+#include "csgrt/reference/cgal_reference.h"
 #include "csgrt/accel/triangle_set.h"
 
 namespace csgrt::test {

@@ -31,8 +31,9 @@ public:
 };
 
 /// The csgrt program (docs/rendering.md): `render SCENE.json -o OUT.exr [options]`,
-/// `info SCENE.json`, `validate SCENE.json`. Returns the exit status: 0 on success, 1 on any
-/// error, reported as one line "csgrt: error: ..." on `err`. Nothing is written to the output
+/// `info SCENE.json`, `validate SCENE.json`. Returns the exit status: 0 on success, 2 for a
+/// usage error (a bad option or argument, a missing scene file), 1 for any other error; an
+/// error is reported as one line "csgrt: error: ..." on `err`. Nothing is written to the output
 /// paths unless the render succeeds, and then each file appears whole.
 int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams);
 

@@ -1,4 +1,4 @@
-#include "csgrt/accel/cgal_reference.h"
+#include "csgrt/reference/cgal_reference.h"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
