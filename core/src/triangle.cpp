@@ -32,7 +32,7 @@ Aabb Triangle::bounds() const {
     return box;
 }
 
-bool Triangle::crossing(const Ray& ray, double& t, double& b1, double& b2) const {
+std::optional<Crossing> Triangle::crossing(const Ray& ray) const {
     // Woop, Benthin and Wald 2013: move the origin to 0, make the dominant direction axis z
     // (so the shear never divides by a small number) and shear x and y so the ray runs along
     // +z. The ray is then the point (0, 0) and the test is a 2D point-in-triangle test. x and
@@ -65,10 +65,10 @@ bool Triangle::crossing(const Ray& ray, double& t, double& b1, double& b2) const
     double e1 = difference_of_products(cx, ay, cy, ax);
     double e2 = difference_of_products(ax, by, ay, bx);
     // Mixed signs: the ray passes outside. Zeros count as inside, so edges are shared.
-    if ((e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0)) return false;
+    if ((e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0)) return {};
     // The e_i share a sign, so det == 0 only when all are 0: a ray in the triangle's plane.
     double det = e0 + e1 + e2;
-    if (det == 0.0) return false;
+    if (det == 0.0) return {};
 
     const double az = shear_z * a[kz], bz = shear_z * b[kz], cz = shear_z * c[kz];
     double t_scaled = e0 * az + e1 * bz + e2 * cz;
@@ -85,28 +85,11 @@ bool Triangle::crossing(const Ray& ray, double& t, double& b1, double& b2) const
     const double upper = ray.t_max * det, lower = ray.t_min * det;
     if (t_scaled > next_up(next_up(next_up(upper))) ||
         t_scaled < next_down(next_down(next_down(lower))))
-        return false;
-    t = t_scaled / det;
-    if (!ray.in_range(t)) return false;
-    b1 = e1 / det;
-    b2 = e2 / det;
-    return true;
-}
-
-bool Triangle::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
-    double t, b1, b2;
-    if (!crossing(ray, t, b1, b2)) return false;
-    record = HitRecord{.t = t,
-                       .shape = this,
-                       .primitive = 0,
-                       .u = static_cast<float>(b1),
-                       .v = static_cast<float>(b2)};
-    return true;
-}
-
-bool Triangle::any_hit(const Ray& ray, QueryScratch&) const {
-    double t, b1, b2;
-    return crossing(ray, t, b1, b2);
+        return {};
+    const double t = t_scaled / det;
+    if (!ray.in_range(t)) return {};
+    return Crossing{
+        .t = t, .u = static_cast<float>(e1 / det), .v = static_cast<float>(e2 / det)};
 }
 
 Hit Triangle::finish(const Ray& ray, const HitRecord& record) const {
@@ -125,5 +108,7 @@ Hit Triangle::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(normal_) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Triangle>;
 
 }  // namespace csgrt
