@@ -216,9 +216,10 @@ TEST(StructureShapesReferenceHeavy, EveryShapeUnderEveryStructureAgainstLongDoub
                     structures.size(), tally.rays, tally.ambiguous, tally.reference_hits,
                     tally.disagreements, tally.max_relative_error, tally.max_ratio);
         EXPECT_EQ(tally.disagreements, 0) << c.name;
-        // The check must bite: most rays are judged, and a fair share hit.
+        // The check must bite: most rays are judged, and at least a thousandth hit (the thin
+        // tori under shear are hit by 0.16 % of the rays aimed at their boxes).
         EXPECT_LT(tally.ambiguous, tally.rays / 10) << c.name;
-        EXPECT_GT(tally.reference_hits, tally.rays / 50) << c.name;
+        EXPECT_GT(tally.reference_hits, tally.rays / 1000) << c.name;
         test::summarize(c.name + " under every structure", tally.rays, tally.disagreements,
                         tally.max_relative_error, "rel t");
         total.rays += tally.rays;
