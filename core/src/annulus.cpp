@@ -27,27 +27,18 @@ Aabb Annulus::bounds() const {
     return detail::disk_bounds(center_, frame_.normal, outer_radius_);
 }
 
-bool Annulus::crossing(const Ray& ray, double& t) const {
-    if (!detail::plane_crossing(ray, center_, frame_.normal, t) || !ray.in_range(t)) return false;
+std::optional<Crossing> Annulus::crossing(const Ray& ray) const {
+    double t;
+    if (!detail::plane_crossing(ray, center_, frame_.normal, t) || !ray.in_range(t)) return {};
     // Squared distances against squared radii, as for the disk: no square root.
     const Vector3 offset = (ray.origin - center_) + t * ray.direction;
     const double squared = offset.squaredNorm();
     if (squared > outer_radius_ * outer_radius_ || squared < inner_radius_ * inner_radius_)
-        return false;
-    return azimuth_.is_full() ||
-           azimuth_.contains(offset.dot(frame_.x_axis), offset.dot(frame_.z_axis));
-}
-
-bool Annulus::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
-    double t;
-    if (!crossing(ray, t)) return false;
-    record = HitRecord{.t = t, .shape = this, .primitive = 0};
-    return true;
-}
-
-bool Annulus::any_hit(const Ray& ray, QueryScratch&) const {
-    double t;
-    return crossing(ray, t);
+        return {};
+    if (!azimuth_.is_full() &&
+        !azimuth_.contains(offset.dot(frame_.x_axis), offset.dot(frame_.z_axis)))
+        return {};
+    return Crossing{.t = t};
 }
 
 Hit Annulus::finish(const Ray& ray, const HitRecord& record) const {
@@ -68,5 +59,7 @@ Hit Annulus::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(frame_.normal) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Annulus>;
 
 }  // namespace csgrt

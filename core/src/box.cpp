@@ -51,29 +51,18 @@ bool Box::line_interval(const Ray& ray, double& t_enter, double& t_exit, int& en
     return enter_face >= 0 && t_enter <= t_exit;
 }
 
-bool Box::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+std::optional<Crossing> Box::crossing(const Ray& ray) const {
     double t_enter, t_exit;
     int enter_face, exit_face;
-    if (!line_interval(ray, t_enter, t_exit, enter_face, exit_face)) return false;
+    if (!line_interval(ray, t_enter, t_exit, enter_face, exit_face)) return {};
     // From inside (t_enter < t_min) the nearest hit is where the ray leaves.
     if (ray.in_range(t_enter)) {
-        record = HitRecord{
-            .t = t_enter, .shape = this, .primitive = static_cast<std::uint32_t>(enter_face)};
-        return true;
+        return Crossing{.t = t_enter, .primitive = static_cast<std::uint32_t>(enter_face)};
     }
     if (ray.in_range(t_exit)) {
-        record = HitRecord{
-            .t = t_exit, .shape = this, .primitive = static_cast<std::uint32_t>(exit_face)};
-        return true;
+        return Crossing{.t = t_exit, .primitive = static_cast<std::uint32_t>(exit_face)};
     }
-    return false;
-}
-
-bool Box::any_hit(const Ray& ray, QueryScratch&) const {
-    double t_enter, t_exit;
-    int enter_face, exit_face;
-    return line_interval(ray, t_enter, t_exit, enter_face, exit_face) &&
-           (ray.in_range(t_enter) || ray.in_range(t_exit));
+    return {};
 }
 
 void Box::find_spans(const Ray& ray, SpanList& spans, QueryScratch&) const {
@@ -113,5 +102,7 @@ Hit Box::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Box>;
 
 }  // namespace csgrt

@@ -154,47 +154,29 @@ detail::LineInterval Cone::solid_interval(const Ray& ray) const {
     return span;
 }
 
-bool Cone::nearest(const Ray& ray, double& t, std::uint32_t& surface) const {
+std::optional<Crossing> Cone::crossing(const Ray& ray) const {
     if (capped_) {
         const detail::LineInterval span = solid_interval(ray);
-        if (span.empty()) return false;
+        if (span.empty()) return {};
         if (ray.in_range(span.t0) && std::isfinite(span.t0)) {
-            t = span.t0;
-            surface = span.surface0;
-            return true;
+            return Crossing{.t = span.t0, .primitive = span.surface0};
         }
         if (ray.in_range(span.t1) && std::isfinite(span.t1)) {
-            t = span.t1;
-            surface = span.surface1;
-            return true;
+            return Crossing{.t = span.t1, .primitive = span.surface1};
         }
-        return false;
+        return {};
     }
-    bool found = detail::nearest_open_surface_hit(
-        ray, side_interval(ray), detail::slab_interval(ray, 0.0, height_, kBaseCap, kTopCap), t,
-        surface);
+    Crossing crossing;
+    const bool found = detail::nearest_open_surface_hit(
+        ray, side_interval(ray), detail::slab_interval(ray, 0.0, height_, kBaseCap, kTopCap),
+        crossing.t, crossing.primitive);
     double t_apex;
     if (pointed_ && apex_on_line(ray, t_apex) && ray.in_range(t_apex) &&
-        (!found || t_apex <= t + apex_reach(ray))) {
-        t = t_apex;
-        surface = kApex;
-        found = true;
+        (!found || t_apex <= crossing.t + apex_reach(ray))) {
+        return Crossing{.t = t_apex, .primitive = kApex};
     }
-    return found;
-}
-
-bool Cone::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
-    double t;
-    std::uint32_t surface;
-    if (!nearest(ray, t, surface)) return false;
-    record = HitRecord{.t = t, .shape = this, .primitive = surface};
-    return true;
-}
-
-bool Cone::any_hit(const Ray& ray, QueryScratch&) const {
-    double t;
-    std::uint32_t surface;
-    return nearest(ray, t, surface);
+    if (!found) return {};
+    return crossing;
 }
 
 void Cone::find_spans(const Ray& ray, SpanList& spans, QueryScratch&) const {
@@ -255,5 +237,7 @@ Hit Cone::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Cone>;
 
 }  // namespace csgrt

@@ -21,24 +21,14 @@ Aabb Disk::bounds() const {
     return detail::disk_bounds(center_, frame_.normal, radius_);
 }
 
-bool Disk::crossing(const Ray& ray, double& t) const {
-    if (!detail::plane_crossing(ray, center_, frame_.normal, t) || !ray.in_range(t)) return false;
+std::optional<Crossing> Disk::crossing(const Ray& ray) const {
+    double t;
+    if (!detail::plane_crossing(ray, center_, frame_.normal, t) || !ray.in_range(t)) return {};
     // Compare squared distances: no square root (the point the seed makes). The offset is
     // formed as (o - c) + t d, which keeps it accurate when o and c are large but close.
     const Vector3 offset = (ray.origin - center_) + t * ray.direction;
-    return offset.squaredNorm() <= radius_ * radius_;
-}
-
-bool Disk::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
-    double t;
-    if (!crossing(ray, t)) return false;
-    record = HitRecord{.t = t, .shape = this, .primitive = 0};
-    return true;
-}
-
-bool Disk::any_hit(const Ray& ray, QueryScratch&) const {
-    double t;
-    return crossing(ray, t);
+    if (!(offset.squaredNorm() <= radius_ * radius_)) return {};
+    return Crossing{.t = t};
 }
 
 Hit Disk::finish(const Ray& ray, const HitRecord& record) const {
@@ -59,5 +49,7 @@ Hit Disk::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(frame_.normal) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Disk>;
 
 }  // namespace csgrt

@@ -27,10 +27,10 @@ PartCylinder::PartCylinder(double radius, double y_min, double y_max, double phi
     bounds_ = Aabb(arc.lower - pad, arc.upper + pad);
 }
 
-bool PartCylinder::nearest(const Ray& ray, double& t) const {
+std::optional<Crossing> PartCylinder::crossing(const Ray& ray) const {
     const detail::LineInterval side =
         detail::infinite_cylinder_interval(ray, radius_, Cylinder::kSide);
-    if (side.empty()) return false;
+    if (side.empty()) return {};
     const detail::LineInterval slab =
         detail::slab_interval(ray, y_min_, y_max_, Cylinder::kBottomCap, Cylinder::kTopCap);
     // Nearest crossing first; one in the removed sector lets the ray on to the far crossing.
@@ -40,24 +40,9 @@ bool PartCylinder::nearest(const Ray& ray, double& t) const {
             continue;
         }
         const Point3 p = ray.at(end);
-        if (azimuth_.contains(p.x(), p.z())) {
-            t = end;
-            return true;
-        }
+        if (azimuth_.contains(p.x(), p.z())) return Crossing{.t = end};
     }
-    return false;
-}
-
-bool PartCylinder::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
-    double t;
-    if (!nearest(ray, t)) return false;
-    record = HitRecord{.t = t, .shape = this, .primitive = 0};
-    return true;
-}
-
-bool PartCylinder::any_hit(const Ray& ray, QueryScratch&) const {
-    double t;
-    return nearest(ray, t);
+    return {};
 }
 
 Hit PartCylinder::finish(const Ray& ray, const HitRecord& record) const {
@@ -85,5 +70,7 @@ Hit PartCylinder::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<PartCylinder>;
 
 }  // namespace csgrt

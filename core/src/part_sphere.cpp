@@ -58,29 +58,16 @@ Aabb PartSphere::bounds() const {
     return box;
 }
 
-bool PartSphere::first_crossing(const Ray& ray, double& t) const {
+std::optional<Crossing> PartSphere::crossing(const Ray& ray) const {
     double roots[2];
-    if (!sphere_.line_roots(ray, roots[0], roots[1])) return false;
+    if (!sphere_.line_roots(ray, roots[0], roots[1])) return {};
     // The nearer root may fall in the removed part; the ray then goes on to the far side.
     for (const double root : roots) {
         if (ray.in_range(root) && in_limits((ray.origin - center()) + root * ray.direction)) {
-            t = root;
-            return true;
+            return Crossing{.t = root};
         }
     }
-    return false;
-}
-
-bool PartSphere::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
-    double t;
-    if (!first_crossing(ray, t)) return false;
-    record = HitRecord{.t = t, .shape = this, .primitive = 0};
-    return true;
-}
-
-bool PartSphere::any_hit(const Ray& ray, QueryScratch&) const {
-    double t;
-    return first_crossing(ray, t);
+    return {};
 }
 
 Hit PartSphere::finish(const Ray& ray, const HitRecord& record) const {
@@ -100,5 +87,7 @@ Hit PartSphere::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<PartSphere>;
 
 }  // namespace csgrt

@@ -48,21 +48,13 @@ bool PartTorus::keeps(const Point3& p) const {
            theta_range_.contains(p.y(), rho - torus_.major_radius());
 }
 
-bool PartTorus::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+std::optional<Crossing> PartTorus::crossing(const Ray& ray) const {
     double roots[4];
     const int count = torus_.line_roots(ray, roots);
     for (int i = 0; i < count; ++i) {
-        if (ray.in_range(roots[i]) && keeps(ray.at(roots[i]))) {
-            record = HitRecord{.t = roots[i], .shape = this, .primitive = 0};
-            return true;
-        }
+        if (ray.in_range(roots[i]) && keeps(ray.at(roots[i]))) return Crossing{.t = roots[i]};
     }
-    return false;
-}
-
-bool PartTorus::any_hit(const Ray& ray, QueryScratch& scratch) const {
-    HitRecord record;
-    return nearest_hit(ray, record, scratch);
+    return {};
 }
 
 Hit PartTorus::finish(const Ray& ray, const HitRecord& record) const {
@@ -73,5 +65,7 @@ Hit PartTorus::finish(const Ray& ray, const HitRecord& record) const {
     hit.shape = this;
     return hit;
 }
+
+template class detail::LeafShape<PartTorus>;
 
 }  // namespace csgrt

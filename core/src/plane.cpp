@@ -7,41 +7,6 @@
 
 namespace csgrt {
 
-SurfaceFrame SurfaceFrame::around(const Normal3& n) {
-    // z_axis = R z for the rotation R described in the header. Written out, it is
-    // (-k nx nz, -s nz, 1 - k nz^2) with s the side of the horizon and k = 1 / (1 + |ny|),
-    // which never divides by less than 1.
-    const double side = n.y() >= 0.0 ? 1.0 : -1.0;
-    const double k = 1.0 / (1.0 + std::abs(n.y()));
-    SurfaceFrame frame;
-    frame.normal = n;
-    frame.z_axis = Vector3(-k * n.x() * n.z(), -side * n.z(), 1.0 - k * n.z() * n.z());
-    frame.x_axis = n.cross(frame.z_axis);
-    return frame;
-}
-
-namespace detail {
-
-Vector3 normalized_or_zero(const Vector3& v) {
-    const double largest = v.cwiseAbs().maxCoeff();
-    if (!(largest > 0.0) || !std::isfinite(largest)) return Vector3::Zero();
-    return (v / largest).normalized();
-}
-
-Aabb disk_bounds(const Point3& center, const Normal3& normal, double radius) {
-    Aabb box;
-    for (int axis = 0; axis < 3; ++axis) {
-        // sqrt(1 - n_i^2) as the norm of the other two components, which does not cancel;
-        // gamma(4) covers its rounding and the product's, the ulp steps the sums'.
-        const double other = std::hypot(normal[(axis + 1) % 3], normal[(axis + 2) % 3]);
-        const double reach = radius * std::min(other, 1.0) * (1.0 + gamma(4));
-        box.lower[axis] = next_down(center[axis] - reach);
-        box.upper[axis] = next_up(center[axis] + reach);
-    }
-    return box;
-}
-
-}  // namespace detail
 
 namespace {
 
@@ -61,20 +26,10 @@ Plane::Plane(const Point3& point, const Normal3& normal) : point_(point) {
     frame_ = SurfaceFrame::around(unit);
 }
 
-bool Plane::crossing(const Ray& ray, double& t) const {
-    return detail::plane_crossing(ray, point_, frame_.normal, t) && ray.in_range(t);
-}
-
-bool Plane::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+std::optional<Crossing> Plane::crossing(const Ray& ray) const {
     double t;
-    if (!crossing(ray, t)) return false;
-    record = HitRecord{.t = t, .shape = this, .primitive = 0};
-    return true;
-}
-
-bool Plane::any_hit(const Ray& ray, QueryScratch&) const {
-    double t;
-    return crossing(ray, t);
+    if (!detail::plane_crossing(ray, point_, frame_.normal, t) || !ray.in_range(t)) return {};
+    return Crossing{.t = t};
 }
 
 Hit Plane::finish(const Ray& ray, const HitRecord& record) const {
@@ -92,5 +47,7 @@ Hit Plane::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(frame_.normal) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Plane>;
 
 }  // namespace csgrt

@@ -40,29 +40,15 @@ Aabb Rectangle::bounds() const {
     return box;
 }
 
-bool Rectangle::crossing(const Ray& ray, double& t, double& s, double& r) const {
-    if (!detail::plane_crossing(ray, corner_, normal_, t) || !ray.in_range(t)) return false;
+std::optional<Crossing> Rectangle::crossing(const Ray& ray) const {
+    double t;
+    if (!detail::plane_crossing(ray, corner_, normal_, t) || !ray.in_range(t)) return {};
     const Vector3 offset = (ray.origin - corner_) + t * ray.direction;
-    s = offset.dot(dual_a_);
-    r = offset.dot(dual_b_);
+    const double s = offset.dot(dual_a_);
+    const double r = offset.dot(dual_b_);
     // Closed: edges and corners belong to the parallelogram.
-    return s >= 0.0 && s <= 1.0 && r >= 0.0 && r <= 1.0;
-}
-
-bool Rectangle::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
-    double t, s, r;
-    if (!crossing(ray, t, s, r)) return false;
-    record = HitRecord{.t = t,
-                       .shape = this,
-                       .primitive = 0,
-                       .u = static_cast<float>(s),
-                       .v = static_cast<float>(r)};
-    return true;
-}
-
-bool Rectangle::any_hit(const Ray& ray, QueryScratch&) const {
-    double t, s, r;
-    return crossing(ray, t, s, r);
+    if (!(s >= 0.0 && s <= 1.0 && r >= 0.0 && r <= 1.0)) return {};
+    return Crossing{.t = t, .u = static_cast<float>(s), .v = static_cast<float>(r)};
 }
 
 Hit Rectangle::finish(const Ray& ray, const HitRecord& record) const {
@@ -81,5 +67,7 @@ Hit Rectangle::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(normal_) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Rectangle>;
 
 }  // namespace csgrt

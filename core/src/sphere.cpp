@@ -69,18 +69,12 @@ bool Sphere::line_roots(const Ray& ray, double& t0, double& t1) const {
     return true;
 }
 
-bool Sphere::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+std::optional<Crossing> Sphere::crossing(const Ray& ray) const {
     double t0, t1;
-    if (!line_roots(ray, t0, t1)) return false;
+    if (!line_roots(ray, t0, t1)) return {};
     const double t = ray.in_range(t0) ? t0 : t1;
-    if (!ray.in_range(t)) return false;
-    record = HitRecord{.t = t, .shape = this, .primitive = 0};
-    return true;
-}
-
-bool Sphere::any_hit(const Ray& ray, QueryScratch&) const {
-    double t0, t1;
-    return line_roots(ray, t0, t1) && (ray.in_range(t0) || ray.in_range(t1));
+    if (!ray.in_range(t)) return {};
+    return Crossing{.t = t};
 }
 
 void Sphere::find_spans(const Ray& ray, SpanList& spans, QueryScratch&) const {
@@ -115,5 +109,7 @@ Hit Sphere::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Sphere>;
 
 }  // namespace csgrt

@@ -192,25 +192,13 @@ int Torus::line_roots(const Ray& ray, double roots[4]) const {
     return kept;
 }
 
-bool Torus::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+std::optional<Crossing> Torus::crossing(const Ray& ray) const {
     double roots[4];
     const int count = line_roots(ray, roots);
     for (int i = 0; i < count; ++i) {
-        if (ray.in_range(roots[i])) {
-            record = HitRecord{.t = roots[i], .shape = this, .primitive = 0};
-            return true;
-        }
+        if (ray.in_range(roots[i])) return Crossing{.t = roots[i]};
     }
-    return false;
-}
-
-bool Torus::any_hit(const Ray& ray, QueryScratch&) const {
-    double roots[4];
-    const int count = line_roots(ray, roots);
-    for (int i = 0; i < count; ++i) {
-        if (ray.in_range(roots[i])) return true;
-    }
-    return false;
+    return {};
 }
 
 void Torus::find_spans(const Ray& ray, SpanList& spans, QueryScratch&) const {
@@ -260,5 +248,7 @@ Hit Torus::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(normal) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Torus>;
 
 }  // namespace csgrt

@@ -32,12 +32,17 @@ Aabb Triangle::bounds() const {
     return box;
 }
 
-bool Triangle::crossing(const Ray& ray, double& t, double& b1, double& b2) const {
+namespace {
+
+/// The watertight test on the corners a, b, c relative to the ray's origin, for t in
+/// [t_min, t_max]. Sets `overflow` (and reports nothing) when t's numerator is not finite.
+inline std::optional<Crossing> watertight_crossing(const Vector3& a, const Vector3& b,
+                                                   const Vector3& c, const Vector3& direction,
+                                                   double t_min, double t_max, bool& overflow) {
     // Woop, Benthin and Wald 2013: move the origin to 0, make the dominant direction axis z
     // (so the shear never divides by a small number) and shear x and y so the ray runs along
     // +z. The ray is then the point (0, 0) and the test is a 2D point-in-triangle test. x and
     // y follow z cyclically; the winding this may flip is carried by the sign of det.
-    const Vector3& direction = ray.direction;
     const int kz = max_dimension(direction);
     const int kx = (kz + 1) % 3;
     const int ky = (kx + 1) % 3;
@@ -48,9 +53,6 @@ bool Triangle::crossing(const Ray& ray, double& t, double& b1, double& b2) const
     // Each vertex is transformed by the same operations whichever triangle it belongs to, so
     // neighbours see identical coordinates for their shared vertices: that is what makes the
     // test watertight.
-    const Vector3 a = vertices_[0] - ray.origin;
-    const Vector3 b = vertices_[1] - ray.origin;
-    const Vector3 c = vertices_[2] - ray.origin;
     const double ax = a[kx] - shear_x * a[kz], ay = a[ky] - shear_y * a[kz];
     const double bx = b[kx] - shear_x * b[kz], by = b[ky] - shear_y * b[kz];
     const double cx = c[kx] - shear_x * c[kz], cy = c[ky] - shear_y * c[kz];
@@ -65,13 +67,17 @@ bool Triangle::crossing(const Ray& ray, double& t, double& b1, double& b2) const
     double e1 = difference_of_products(cx, ay, cy, ax);
     double e2 = difference_of_products(ax, by, ay, bx);
     // Mixed signs: the ray passes outside. Zeros count as inside, so edges are shared.
-    if ((e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0)) return false;
+    if ((e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0)) return {};
     // The e_i share a sign, so det == 0 only when all are 0: a ray in the triangle's plane.
     double det = e0 + e1 + e2;
-    if (det == 0.0) return false;
+    if (det == 0.0) return {};
 
     const double az = shear_z * a[kz], bz = shear_z * b[kz], cz = shear_z * c[kz];
     double t_scaled = e0 * az + e1 * bz + e2 * cz;
+    if (!std::isfinite(t_scaled)) {
+        overflow = true;
+        return {};
+    }
     if (det < 0.0) {
         det = -det;
         t_scaled = -t_scaled;
@@ -82,31 +88,48 @@ bool Triangle::crossing(const Ray& ray, double& t, double& b1, double& b2) const
     // widened by three ulps, more than their own rounding plus that of the division, so a
     // triangle is culled only when the divided t would be outside too (barring underflow):
     // the decision itself is made on the divided t, like every other shape's.
-    const double upper = ray.t_max * det, lower = ray.t_min * det;
+    const double upper = t_max * det, lower = t_min * det;
     if (t_scaled > next_up(next_up(next_up(upper))) ||
         t_scaled < next_down(next_down(next_down(lower))))
-        return false;
-    t = t_scaled / det;
-    if (!ray.in_range(t)) return false;
-    b1 = e1 / det;
-    b2 = e2 / det;
-    return true;
+        return {};
+    const double t = t_scaled / det;
+    if (!(t >= t_min && t <= t_max)) return {};
+    return Crossing{
+        .t = t, .u = static_cast<float>(e1 / det), .v = static_cast<float>(e2 / det)};
 }
 
-bool Triangle::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
-    double t, b1, b2;
-    if (!crossing(ray, t, b1, b2)) return false;
-    record = HitRecord{.t = t,
-                       .shape = this,
-                       .primitive = 0,
-                       .u = static_cast<float>(b1),
-                       .v = static_cast<float>(b2)};
-    return true;
+/// The slow path of Triangle::crossing for corners whose coordinates overflow t's numerator.
+[[gnu::noinline]] std::optional<Crossing> scaled_crossing(const Vector3& a, const Vector3& b,
+                                                         const Vector3& c, const Ray& ray) {
+    bool overflow = false;
+    // Coordinates beyond about 2^340 overflow the cubic numerator of t (a hit at infinity, or
+    // NaN). Scaling them by a power of two is exact, keeps every edge function's sign (so the
+    // test stays watertight) and the barycentrics, and divides t by the same power.
+    const double extent =
+        std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), c.cwiseAbs().maxCoeff()});
+    if (!std::isfinite(extent)) return {};
+    const int exponent = std::ilogb(extent);
+    const double scale = std::ldexp(1.0, -exponent);
+    std::optional<Crossing> scaled =
+        watertight_crossing(a * scale, b * scale, c * scale, ray.direction,
+                            std::ldexp(ray.t_min, -exponent), std::ldexp(ray.t_max, -exponent),
+                            overflow);
+    if (scaled) scaled->t = std::ldexp(scaled->t, exponent);
+    return scaled;
 }
 
-bool Triangle::any_hit(const Ray& ray, QueryScratch&) const {
-    double t, b1, b2;
-    return crossing(ray, t, b1, b2);
+}  // namespace
+
+std::optional<Crossing> Triangle::crossing(const Ray& ray) const {
+    const Vector3 a = vertices_[0] - ray.origin;
+    const Vector3 b = vertices_[1] - ray.origin;
+    const Vector3 c = vertices_[2] - ray.origin;
+    bool overflow = false;
+    const std::optional<Crossing> crossing =
+        watertight_crossing(a, b, c, ray.direction, ray.t_min, ray.t_max, overflow);
+    if (!overflow) [[likely]]
+        return crossing;
+    return scaled_crossing(a, b, c, ray);
 }
 
 Hit Triangle::finish(const Ray& ray, const HitRecord& record) const {
@@ -125,5 +148,7 @@ Hit Triangle::finish(const Ray& ray, const HitRecord& record) const {
     hit.front_face = ray.direction.dot(normal_) < 0.0;
     return hit;
 }
+
+template class detail::LeafShape<Triangle>;
 
 }  // namespace csgrt

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "csgrt/core/error.h"
+#include "support/error_of.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -10,15 +11,7 @@ namespace {
 
 using LongVector = Eigen::Matrix<long double, 3, 1>;
 
-template <class Make>
-std::string error_of(Make make) {
-    try {
-        make();
-    } catch (const InvalidParameter& error) {
-        return error.what();
-    }
-    return "no exception";
-}
+using test::error_of;
 
 const Normal3 kUp(0, 1, 0);
 // r in [1, 2] at height 1, all the way round.

@@ -6,20 +6,13 @@
 #include <Eigen/Geometry>
 
 #include "csgrt/core/error.h"
+#include "support/error_of.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
 namespace {
 
-template <class Make>
-std::string error_of(Make make) {
-    try {
-        make();
-    } catch (const InvalidParameter& error) {
-        return error.what();
-    }
-    return "no exception";
-}
+using test::error_of;
 
 const Box kCube(Point3(-1, -1, -1), Point3(1, 1, 1));
 

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "csgrt/core/error.h"
+#include "support/error_of.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -13,15 +14,7 @@ namespace {
 
 using LongVector = Eigen::Matrix<long double, 3, 1>;
 
-template <class Make>
-std::string error_of(Make make) {
-    try {
-        make();
-    } catch (const InvalidParameter& error) {
-        return error.what();
-    }
-    return "no exception";
-}
+using test::error_of;
 
 const Point3 kOrigin(0, 0, 0);
 // The half x >= 0 (phi in [0, pi]) of the unit sphere.

@@ -5,20 +5,13 @@
 #include <Eigen/Dense>
 
 #include "csgrt/core/error.h"
+#include "support/error_of.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
 namespace {
 
-template <class Make>
-std::string error_of(Make make) {
-    try {
-        make();
-    } catch (const InvalidParameter& error) {
-        return error.what();
-    }
-    return "no exception";
-}
+using test::error_of;
 
 // 2 along z, 3 along x: normal (0, 0, 2) x (3, 0, 0) = (0, 6, 0), i.e. +y.
 const Rectangle kRectangle(Point3(0, 0, 0), Vector3(0, 0, 2), Vector3(3, 0, 0));

@@ -22,6 +22,7 @@
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
 #include "stress/summary.h"
+#include "support/example_shapes.h"
 #include "support/meshes.h"
 #include "support/random.h"
 
@@ -319,6 +320,63 @@ TEST(DegenerateGeometry, AcceptedShapesAnswerEveryQueryWellFormed) {
     std::printf("  %zu accepted degenerate shapes, %ld queries\n", accepted_cases().size(),
                 queries);
     test::summarize("degenerate shapes accepted and queried", queries, test::failed_assertions());
+}
+
+TEST(DegenerateGeometry, EveryRegisteredKindAtExtremeSizesAnswersWellFormed) {
+    // Every kind of the registry (support/example_shapes.h) built by its own parameters at
+    // sizes 1e-300, 1e-150, 1e150 and 1e300 around the origin: a constructor may refuse a size
+    // (InvalidParameter, a defined answer), otherwise every query is well formed as above (t in
+    // the interval, finite point, unit normals, uv in [0, 1], ordered spans, occluded equal to
+    // intersect). The unit directions of random.ray_between keep |d|^2 a normal double.
+    test::Random random(29);
+    long queries = 0, refused = 0, hits = 0;
+    for (const test::ExampleKind& kind : test::example_kinds()) {
+        for (const double size : {1e-300, 1e-150, 1e150, 1e300}) {
+            std::shared_ptr<const Shape> shape;
+            Point3 placed;
+            try {
+                shape = kind.make(Point3(0, 0, 0), size, placed).first;
+            } catch (const InvalidParameter&) {
+                ++refused;
+                continue;
+            }
+            const Aabb region(Point3::Constant(-size), Point3::Constant(size));
+            const Aabb from = test::enlarged(region, 2.0);
+            for (int i = 0; i < 300; ++i) {
+                const Ray ray = random.ray_between(from, region);
+                const std::optional<Hit> hit = shape->intersect(ray);
+                const std::string where =
+                    kind.name + " size " + std::to_string(size) + ", ray " + std::to_string(i);
+                EXPECT_EQ(shape->occluded(ray), hit.has_value()) << where;
+                if (hit) {
+                    ++hits;
+                    EXPECT_TRUE(ray.in_range(hit->t)) << where;
+                    EXPECT_TRUE(is_finite(hit->point)) << where;
+                    EXPECT_NEAR(hit->geometric_normal.norm(), 1.0, 1e-9) << where;
+                    EXPECT_NEAR(hit->shading_normal.norm(), 1.0, 1e-9) << where;
+                    EXPECT_TRUE(hit->uv.x() >= 0.0 && hit->uv.x() <= 1.0 && hit->uv.y() >= 0.0 &&
+                                hit->uv.y() <= 1.0)
+                        << where;
+                }
+                if (shape->is_solid()) {
+                    const SpanList spans = shape->spans(ray);
+                    for (std::size_t k = 0; k < spans.size(); ++k) {
+                        EXPECT_LE(spans[k].enter.t, spans[k].exit.t) << where;
+                        if (k > 0) {
+                            EXPECT_LE(spans[k - 1].exit.t, spans[k].enter.t) << where;
+                        }
+                    }
+                }
+                queries += 3;
+            }
+        }
+    }
+    std::printf("  registry kinds at extreme sizes: %ld queries, %ld hits, %ld sizes refused\n",
+                queries, hits, refused);
+    // The rays aim into the region the shapes fill: far more than a few must hit.
+    EXPECT_GT(hits, queries / 100);
+    test::summarize("registry kinds at sizes 1e-300 to 1e300", queries,
+                    test::failed_assertions());
 }
 
 }  // namespace

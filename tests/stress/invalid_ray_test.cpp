@@ -30,6 +30,7 @@
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
 #include "stress/summary.h"
+#include "support/example_shapes.h"
 #include "support/meshes.h"
 #include "support/random.h"
 
@@ -138,34 +139,20 @@ std::vector<NamedRay> extreme_valid_rays() {
     return rays;
 }
 
+/// The registry, built once so that names can be looked up by shape.
+const std::vector<test::ExampleShape>& registered() {
+    static const std::vector<test::ExampleShape> list = test::example_shapes();
+    return list;
+}
+
+/// Every registered example shape (support/example_shapes.h), then the octahedral sphere mesh
+/// under every structure in float and double.
 std::vector<std::shared_ptr<const Shape>> every_shape() {
-    auto sphere = std::make_shared<Sphere>(Point3(0, 0, 0), 1.0);
-    auto box = std::make_shared<Box>(Point3(-1, -1, -1), Point3(1, 1, 1));
+    std::vector<std::shared_ptr<const Shape>> shapes;
+    for (const test::ExampleShape& example : registered()) {
+        shapes.push_back(example.shape);
+    }
     const test::TestMesh octahedron = test::sphere_mesh(2);
-    std::vector<std::shared_ptr<const Shape>> shapes = {
-        std::make_shared<Plane>(Point3(0, 0, 0), Normal3(0, 0.2, 1)),
-        std::make_shared<Triangle>(Point3(-1, -1, 0), Point3(1, -1, 0), Point3(0, 1, 0)),
-        std::make_shared<Disk>(Point3(0, 0, 0), Normal3(0, 0, 1), 1.0),
-        std::make_shared<Rectangle>(Point3(-1, -1, 0), Vector3(2, 0, 0), Vector3(0, 2, 0)),
-        std::make_shared<Annulus>(Point3(0, 0, 0), Normal3(0, 0, 1), 0.05, 1.0, 1.0, 7.0),
-        box,
-        sphere,
-        std::make_shared<PartSphere>(Point3(0, 0, 0), 1.0, 1.0, 7.0, 0.2, 2.9),
-        std::make_shared<Cylinder>(1.0, -1.0, 1.0, false),
-        std::make_shared<Cylinder>(1.0, -1.0, 1.0, true),
-        std::make_shared<Cone>(1.0, 0.0, 2.0, true),
-        std::make_shared<Cone>(1.0, 0.5, 2.0, false),
-        std::make_shared<PartCylinder>(1.0, -1.0, 1.0, 1.0, 7.0),
-        std::make_shared<Torus>(1.0, 0.25),
-        std::make_shared<Torus>(1.0, 1e-3),
-        std::make_shared<PartTorus>(1.0, 0.25, 1.0, 7.0, 4.0, 9.0),
-        std::make_shared<Instance>(sphere, Transform::rotate(Vector3(1, 2, 3), 0.5) *
-                                               Transform::scale(Vector3(2, 1, 0.5))),
-        std::make_shared<Boolean>(BooleanOperation::Difference, box, sphere),
-        std::make_shared<Boolean>(
-            BooleanOperation::Union, box,
-            std::make_shared<Instance>(sphere, Transform::translate(Vector3(1, 0, 0)))),
-    };
     for (const std::string_view name : accelerator_names()) {
         for (const bool double_precision : {false, true}) {
             MeshConfig config;
@@ -179,6 +166,9 @@ std::vector<std::shared_ptr<const Shape>> every_shape() {
 }
 
 std::string shape_name(const Shape& shape) {
+    for (const test::ExampleShape& example : registered()) {
+        if (example.shape.get() == &shape) return example.name;
+    }
     if (const auto* mesh = dynamic_cast<const Mesh*>(&shape)) {
         return "mesh (" + mesh->accelerator_stats().name +
                (mesh->double_precision() ? ", double)" : ", float)");
@@ -240,22 +230,27 @@ TEST(InvalidRays, TinyAndHugeValidDirectionsGiveTheSameHitPoint) {
     // |d| = 2^-500 (about 3e-151) and 2^500 are valid (|d|^2 is a normal double). Scaling by a
     // power of two is exact, so the scaled ray names exactly the same points and the hit point
     // o + t d must be the unit direction's up to the rounding of a point: 8 u (|o| + |p|), a few
-    // ulps of the coordinates. Half the rays aim at the unit circle of the xz plane, which lies
-    // on or inside every shape here (the thin torus included), the other half anywhere in the
-    // unit cube; 200 rays a shape.
+    // ulps of the coordinates. Rays from a box 4 sizes around each shape aim at random points
+    // of the box rays aim into (example.target); candidates are drawn until 100 of them hit
+    // with the unit direction (at most 200000), so thin shapes (a torus with r/R = 1e-3) are
+    // compared as often as thick ones.
     test::Random random(17);
     long total = 0;
     for (const auto& shape : every_shape()) {
         const std::string name = shape_name(*shape);
-        int compared = 0;
-        for (int i = 0; i < 200; ++i) {
-            const Point3 origin = random.in_box(Aabb(Point3(-4, -4, -4), Point3(4, 4, 4)));
-            const double angle = random.uniform(0.0, 2.0 * kPi);
-            const Point3 target = i % 2 == 0
-                                      ? Point3(std::sin(angle), 0.0, std::cos(angle))
-                                      : random.in_box(Aabb(Point3(-1, -1, -1), Point3(1, 1, 1)));
-            const Vector3 direction = (target - origin).normalized();
+        Aabb target = shape->bounds();
+        for (const test::ExampleShape& example : registered()) {
+            if (example.shape == shape) target = example.target;
+        }
+        const Point3 middle = target.center();
+        const double size = std::max(1.0, (target.upper - target.lower).maxCoeff());
+        const Aabb around(middle - Vector3::Constant(4 * size), middle + Vector3::Constant(4 * size));
+        int compared = 0, reference_hits = 0;
+        for (int i = 0; i < 200000 && reference_hits < 100; ++i) {
+            const Point3 origin = random.in_box(around);
+            const Vector3 direction = (random.in_box(target) - origin).normalized();
             const std::optional<Hit> reference = shape->intersect(Ray{origin, direction});
+            if (reference) ++reference_hits;
             for (const double length : {0x1p-500, 0x1p500}) {
                 const Ray scaled{origin, direction * length};
                 const std::optional<Hit> hit = shape->intersect(scaled);
@@ -270,8 +265,7 @@ TEST(InvalidRays, TinyAndHugeValidDirectionsGiveTheSameHitPoint) {
                 EXPECT_EQ(hit->shape, reference->shape);
             }
         }
-        // Each hit counts at both lengths: over 60 means at least 30 of the 200 rays hit (the
-        // flat shapes catch few of those aimed at the circle).
+        // Each hit counts at both lengths: over 60 means at least 30 rays hit.
         EXPECT_GT(compared, 60) << name;
         total += compared;
     }

@@ -3,22 +3,7 @@
 // Instance; rays from 0.5 to 1e6 sizes away, grazing rays and rays along the axes. Every
 // answer is judged against the long double model of tests/stress/reference_shapes.h.
 //
-// The tolerances, in units of the point scale s(t) = u (|o| + |t| |d| + |c| + size) (u = 2^-53,
-// c the object's centre): the rounding of a point's coordinates, below which no double
-// computation can place a hit.
-// - A root-finder that is backward stable returns the exact crossing of a ray whose points are
-//   off by a few roundings of s: mapping the ray into object space (3 roundings of |o| + |c| per
-//   coordinate), moving the origin to the closest approach (2), evaluating the surface's
-//   function there (about 8 of its terms, which are of the object's size) and the last
-//   o + t d (2); 15 in all. Along the ray that becomes s / (|d| cos a), a the angle between
-//   the ray and the normal. kRootUlps = 32 allows twice that; 4 ulps of t cover the division
-//   that forms t.
-// - A crossing within kTrimBand = 2 kRootUlps point scales / cos a of a trim (an edge, a rim,
-//   an angle limit) may land on either side of it: ambiguous, counted, not judged.
-// - A line within kTangentBand = 64 point scales of touching a curved surface is ambiguous
-//   (touch or near miss; the torus's measured band is 2-4, docs/accuracy.md), and so is a line
-//   through a cone's apex within sqrt(u) relative (the cone attributes hits that close to the
-//   apex, docs/shapes.md).
+// The tolerances and the ambiguity bands are stated and derived in reference_judge.h.
 
 #include <gtest/gtest.h>
 
@@ -32,161 +17,37 @@
 #include <vector>
 
 #include "csgrt/core/shapes.h"
+#include "stress/reference_judge.h"
 #include "stress/reference_shapes.h"
 #include "stress/stress_config.h"
+#include "support/example_shapes.h"
 #include "stress/summary.h"
 #include "support/random.h"
 
 namespace csgrt {
 namespace {
 
+using test::error_bound;
+using test::judge;
+using test::kRootUlps;
 using test::Long;
 using test::LongVector;
+using test::point_scale;
+using test::Verdict;
 
-constexpr double kRootUlps = 32.0;
-constexpr double kTrimBand = 2.0 * kRootUlps;
-constexpr double kTangentBand = 64.0;
 
 using ShapePointer = std::shared_ptr<const Shape>;
 using ReferencePointer = std::shared_ptr<const test::ReferenceShape>;
 
 /// One shape placed in the world, with its long double model.
-struct Case {
+struct Case : test::JudgedShape {
     std::string kind;
     std::string placement;
     bool instanced = false;
     ShapePointer shape;
-    ReferencePointer reference;
-    Point3 center;
-    double size = 1.0;
     /// The world box rays aim into.
     Aabb target;
 };
-
-/// A kind of shape, built at a size near a centre by its own parameters. `placed` receives the
-/// centre it really has (shapes of revolution sit on their axis).
-struct Kind {
-    std::string name;
-    std::function<std::pair<ShapePointer, ReferencePointer>(const Point3& center, double size,
-                                                            Point3& placed)>
-        make;
-};
-
-template <class S>
-std::shared_ptr<const S> shared(std::shared_ptr<S> shape) {
-    return shape;
-}
-
-std::vector<Kind> kinds() {
-    std::vector<Kind> list;
-    list.push_back({"plane", [](const Point3& c, double s, Point3& placed) {
-                        placed = c;
-                        const Normal3 normal(1, 2, 3);
-                        (void)s;
-                        return std::make_pair(ShapePointer(std::make_shared<Plane>(c, normal)),
-                                              ReferencePointer(test::reference_plane(c, normal)));
-                    }});
-    list.push_back({"triangle", [](const Point3& c, double s, Point3& placed) {
-                        placed = c;
-                        const Point3 a = c + s * Vector3(-1, -0.5, 0.2);
-                        const Point3 b = c + s * Vector3(1, -0.3, -0.1);
-                        const Point3 d = c + s * Vector3(0.1, 1, 0.3);
-                        return std::make_pair(ShapePointer(std::make_shared<Triangle>(a, b, d)),
-                                              ReferencePointer(test::reference_triangle(a, b, d)));
-                    }});
-    list.push_back({"disk", [](const Point3& c, double s, Point3& placed) {
-                        placed = c;
-                        const Normal3 normal(-1, 2, 0.5);
-                        return std::make_pair(ShapePointer(std::make_shared<Disk>(c, normal, s)),
-                                              ReferencePointer(test::reference_disk(c, normal, s)));
-                    }});
-    list.push_back({"rectangle", [](const Point3& c, double s, Point3& placed) {
-                        placed = c;
-                        const Point3 corner = c - s * Vector3(0.5, 0.2, 0.3);
-                        const Vector3 a = s * Vector3(1, 0.2, -0.1);
-                        const Vector3 b = s * Vector3(-0.3, 0.8, 0.4);
-                        return std::make_pair(
-                            ShapePointer(std::make_shared<Rectangle>(corner, a, b)),
-                            ReferencePointer(test::reference_rectangle(corner, a, b)));
-                    }});
-    list.push_back(
-        {"annulus", [](const Point3& c, double s, Point3& placed) {
-             placed = c;
-             // The azimuth range [4, 8.5] runs across the seam 0 = 2 pi.
-             auto annulus =
-                 std::make_shared<Annulus>(c, Normal3(0.3, -1, 0.2), 0.4 * s, s, 4.0, 8.5);
-             const SurfaceFrame& frame = annulus->frame();
-             return std::make_pair(ShapePointer(annulus), ReferencePointer(test::reference_annulus(
-                                                              c, frame.normal, frame.x_axis,
-                                                              frame.z_axis, 0.4 * s, s, 4.0, 8.5)));
-         }});
-    list.push_back({"box", [](const Point3& c, double s, Point3& placed) {
-                        placed = c;
-                        const Vector3 half = s * Vector3(1, 0.5, 0.75);
-                        return std::make_pair(
-                            ShapePointer(std::make_shared<Box>(c - half, c + half)),
-                            ReferencePointer(test::reference_box(c - half, c + half)));
-                    }});
-    list.push_back({"sphere", [](const Point3& c, double s, Point3& placed) {
-                        placed = c;
-                        return std::make_pair(ShapePointer(std::make_shared<Sphere>(c, s)),
-                                              ReferencePointer(test::reference_sphere(c, s)));
-                    }});
-    list.push_back(
-        {"part_sphere", [](const Point3& c, double s, Point3& placed) {
-             placed = c;
-             return std::make_pair(
-                 ShapePointer(std::make_shared<PartSphere>(c, s, 4.0, 8.0, 0.6, 2.2)),
-                 ReferencePointer(test::reference_part_sphere(c, s, 4.0, 8.0, 0.6, 2.2)));
-         }});
-    for (const bool capped : {false, true}) {
-        list.push_back(
-            {capped ? "cylinder (capped)" : "cylinder (open)",
-             [capped](const Point3& c, double s, Point3& placed) {
-                 placed = Point3(0, c.y(), 0);
-                 return std::make_pair(
-                     ShapePointer(std::make_shared<Cylinder>(s, c.y() - s, c.y() + s, capped)),
-                     ReferencePointer(test::reference_cylinder(s, c.y() - s, c.y() + s, capped)));
-             }});
-    }
-    list.push_back({"cone (open frustum)", [](const Point3&, double s, Point3& placed) {
-                        placed = Point3(0, s, 0);
-                        return std::make_pair(
-                            ShapePointer(std::make_shared<Cone>(s, 0.4 * s, 2 * s, false)),
-                            ReferencePointer(test::reference_cone(s, 0.4 * s, 2 * s, false)));
-                    }});
-    list.push_back({"cone (capped, pointed)", [](const Point3&, double s, Point3& placed) {
-                        placed = Point3(0, s, 0);
-                        return std::make_pair(
-                            ShapePointer(std::make_shared<Cone>(s, 0.0, 2 * s, true)),
-                            ReferencePointer(test::reference_cone(s, 0.0, 2 * s, true)));
-                    }});
-    list.push_back({"part_cylinder", [](const Point3& c, double s, Point3& placed) {
-                        placed = Point3(0, c.y(), 0);
-                        return std::make_pair(ShapePointer(std::make_shared<PartCylinder>(
-                                                  s, c.y() - s, c.y() + s, 4.5, 8.0)),
-                                              ReferencePointer(test::reference_part_cylinder(
-                                                  s, c.y() - s, c.y() + s, 4.5, 8.0)));
-                    }});
-    for (const double ratio : {0.25, 1e-2, 1e-3}) {
-        char name[32];
-        std::snprintf(name, sizeof name, "torus r/R=%g", ratio);
-        list.push_back({name, [ratio](const Point3&, double s, Point3& placed) {
-                            placed = Point3(0, 0, 0);
-                            return std::make_pair(
-                                ShapePointer(std::make_shared<Torus>(s, ratio * s)),
-                                ReferencePointer(test::reference_torus(s, ratio * s)));
-                        }});
-    }
-    list.push_back(
-        {"part_torus", [](const Point3&, double s, Point3& placed) {
-             placed = Point3(0, 0, 0);
-             return std::make_pair(
-                 ShapePointer(std::make_shared<PartTorus>(s, 0.25 * s, 5.0, 9.0, 4.2, 7.7)),
-                 ReferencePointer(test::reference_part_torus(s, 0.25 * s, 5.0, 9.0, 4.2, 7.7)));
-         }});
-    return list;
-}
 
 struct Placement {
     std::string name;
@@ -215,7 +76,7 @@ Aabb target_box(const Shape& shape, const Point3& center, double size) {
 
 std::vector<Case> all_cases() {
     std::vector<Case> cases;
-    for (const Kind& kind : kinds()) {
+    for (const test::ExampleKind& kind : test::example_kinds()) {
         for (const Placement& placement : placements()) {
             Case own;
             own.kind = kind.name;
@@ -244,79 +105,12 @@ std::vector<Case> all_cases() {
                 unit_reference, world_from_object.linear(), world_from_object.translation());
             instanced.center = world_from_object.apply_point(unit_center);
             instanced.size = placement.size;
+            instanced.object_scale = placement.size;
             instanced.target = target_box(*instanced.shape, instanced.center, instanced.size);
             cases.push_back(instanced);
         }
     }
     return cases;
-}
-
-/// What the reference says the nearest hit in [0, inf) is.
-struct Verdict {
-    bool ambiguous = false;
-    bool hit = false;
-    Long t = 0;
-    Long cosine = 1;
-    /// The kept crossings at t >= 0, in order (for the spans of solids), and whether any of
-    /// them (or a near tangency) is ambiguous.
-    std::vector<test::Crossing> boundaries;
-    bool boundaries_ambiguous = false;
-};
-
-double point_scale(const Ray& ray, double t, const Case& c) {
-    return kUnitRoundoff *
-           (ray.origin.norm() + std::abs(t) * ray.direction.norm() + c.center.norm() + c.size);
-}
-
-Verdict judge(const Case& c, const Ray& ray) {
-    test::LineCrossings line;
-    c.reference->crossings(test::to_long(ray), line);
-    std::sort(line.crossings.begin(), line.crossings.end(),
-              [](const test::Crossing& a, const test::Crossing& b) { return a.t < b.t; });
-    // Object-space distances: world distances over the instance's scale.
-    const double scale = c.instanced ? c.size : 1.0;
-    const double length = ray.direction.norm();
-    Verdict verdict;
-    bool nearest_found = false;
-    for (const test::Crossing& crossing : line.crossings) {
-        const double t = static_cast<double>(crossing.t);
-        const double s = point_scale(ray, t, c) / scale;
-        const double cosine = std::max(static_cast<double>(crossing.cosine), 1e-300);
-        const double band = kTrimBand * s / cosine;
-        const double along = t * length / scale;   // object-space distance from the origin
-        if (along < -band) continue;               // well behind the origin
-        bool ambiguous = std::abs(along) <= band;  // the origin is on the surface
-        ambiguous |= std::abs(static_cast<double>(crossing.trim_distance)) <= band;
-        if (ambiguous) {
-            verdict.boundaries_ambiguous = true;
-            if (!nearest_found) verdict.ambiguous = true;
-            nearest_found = true;
-            continue;
-        }
-        if (crossing.t < 0 || crossing.trim_distance < 0) continue;
-        verdict.boundaries.push_back(crossing);
-        if (!nearest_found) {
-            nearest_found = true;
-            verdict.hit = true;
-            verdict.t = crossing.t;
-            verdict.cosine = crossing.cosine;
-        }
-    }
-    for (const test::NearTangency& tangency : line.tangencies) {
-        const double t = static_cast<double>(tangency.t);
-        const double s = point_scale(ray, t, c) / scale;
-        const bool singular = tangency.trim_distance == 0;  // an apex
-        const double band =
-            singular ? std::sqrt(kUnitRoundoff) * s / kUnitRoundoff : kTangentBand * s;
-        if (!(tangency.distance <= band) || tangency.trim_distance < -kTrimBand * s) continue;
-        // A near-tangent line crosses within about sqrt(2 rho band) of the touching point,
-        // rho (the curvature radius) at most the object's size.
-        const double window = 2.0 * std::sqrt(2.0 * c.size * band * scale) / length;
-        if (t < -window) continue;
-        verdict.boundaries_ambiguous = true;
-        if (!verdict.hit || t <= static_cast<double>(verdict.t) + window) verdict.ambiguous = true;
-    }
-    return verdict;
 }
 
 struct Tally {
@@ -365,11 +159,6 @@ std::string describe(const Case& c, const Ray& ray) {
                   ray.origin.x(), ray.origin.y(), ray.origin.z(), ray.direction.x(),
                   ray.direction.y(), ray.direction.z());
     return text;
-}
-
-double error_bound(const Case& c, const Ray& ray, double t, double cosine) {
-    return kRootUlps * point_scale(ray, t, c) / (ray.direction.norm() * std::max(cosine, 1e-300)) +
-           4.0 * kUnitRoundoff * std::abs(t);
 }
 
 /// Checks one ray; returns the finished hit (if any) so callers can build grazing rays from it.

@@ -2,7 +2,7 @@
 
 #include "csgrt/core/angle_range.h"
 #include "csgrt/core/plane.h"
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 
 namespace csgrt {
 
@@ -16,7 +16,7 @@ namespace csgrt {
 /// to every azimuth; a ray parallel to the plane never hits; the normal is the one given;
 /// uv = ((r - inner) / (outer - inner), where phi lies in the range), so a full-range annulus
 /// with inner radius 0 has the Disk's uv.
-class Annulus final : public Shape {
+class Annulus final : public detail::LeafShape<Annulus> {
 public:
     /// Throws InvalidParameter unless center is finite, normal finite and non-zero,
     /// 0 <= inner_radius < outer_radius < infinity and the azimuth range is valid.
@@ -27,9 +27,9 @@ public:
     /// The bounds of the outer disk (not trimmed by the azimuth range).
     Aabb bounds() const override;
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The point in [t_min, t_max] where the ray crosses the annulus, if any.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     const Point3& center() const { return center_; }
     /// The unit normal.
@@ -40,7 +40,6 @@ public:
     const AngleRange& azimuth() const { return azimuth_; }
 
 private:
-    bool crossing(const Ray& ray, double& t) const;
 
     Point3 center_;
     SurfaceFrame frame_;
@@ -48,5 +47,7 @@ private:
     double outer_radius_;
     AngleRange azimuth_;
 };
+
+extern template class detail::LeafShape<Annulus>;
 
 }  // namespace csgrt

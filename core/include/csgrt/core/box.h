@@ -1,6 +1,6 @@
 #pragma once
 
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 
 namespace csgrt {
 
@@ -14,7 +14,7 @@ namespace csgrt {
 /// lies in a face plane and crosses the face, or touches only an edge or a corner, hits it
 /// (a zero-length span for a single point). Where the ray enters through an edge or corner,
 /// the face of the lowest axis is reported.
-class Box final : public Shape {
+class Box final : public detail::LeafShape<Box> {
 public:
     /// Throws InvalidParameter unless lower and upper are finite and lower < upper on every
     /// axis.
@@ -24,12 +24,13 @@ public:
     Aabb bounds() const override { return Aabb(lower_, upper_); }
     bool is_solid() const override { return true; }
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
     /// Closed: points on the faces are inside.
     bool contains(const Point3& p) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The nearest point in [t_min, t_max] where the ray meets the box (from inside: where it
+    /// leaves); `primitive` is the face.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     const Point3& lower() const { return lower_; }
     const Point3& upper() const { return upper_; }
@@ -43,5 +44,7 @@ private:
     Point3 lower_;
     Point3 upper_;
 };
+
+extern template class detail::LeafShape<Box>;
 
 }  // namespace csgrt

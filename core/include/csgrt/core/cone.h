@@ -3,7 +3,7 @@
 #include <cstdint>
 
 #include "csgrt/core/cylinder.h"
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 
 namespace csgrt {
 
@@ -28,7 +28,7 @@ namespace csgrt {
 /// cap radius); at the apex: (0, y / height). A ray lying in the side (along a generator)
 /// crosses nothing, as on an open Cylinder, but passes the apex of a pointed cone and so hits
 /// that; the capped solid is hit where its span begins (a rim or the apex).
-class Cone final : public Shape {
+class Cone final : public detail::LeafShape<Cone> {
 public:
     /// Which surface a hit lies on: HitRecord::primitive and Hit::primitive_id.
     enum Surface : std::uint32_t { kSide = 0, kBaseCap = 1, kTopCap = 2, kApex = 3 };
@@ -41,11 +41,12 @@ public:
     Aabb bounds() const override;
     bool is_solid() const override { return capped_; }
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
     bool contains(const Point3& p) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The nearest point in [t_min, t_max] where the ray meets the surface (the solid's span
+    /// ends when capped); `primitive` is the Surface.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     double base_radius() const { return base_radius_; }
     double top_radius() const { return top_radius_; }
@@ -65,7 +66,6 @@ private:
     /// How far in t from the apex a hit is attributed to it.
     double apex_reach(const Ray& ray) const;
     detail::LineInterval solid_interval(const Ray& ray) const;
-    bool nearest(const Ray& ray, double& t, std::uint32_t& surface) const;
 
     double base_radius_;
     double top_radius_;
@@ -80,5 +80,7 @@ private:
     Point3 center_;
     double size_;
 };
+
+extern template class detail::LeafShape<Cone>;
 
 }  // namespace csgrt

@@ -2,7 +2,8 @@
 
 #include <cstdint>
 
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
+#include "csgrt/core/line_interval.h"
 
 namespace csgrt {
 
@@ -22,7 +23,7 @@ namespace csgrt {
 /// first point of contact would be at t_min whatever t_min is, so a ray spawned along the
 /// surface would always re-hit it. The open cylinder is therefore missed, as flat shapes are
 /// by rays in their plane; the capped solid is hit at its caps' rims, the ends of its span.
-class Cylinder final : public Shape {
+class Cylinder final : public detail::LeafShape<Cylinder> {
 public:
     /// Which surface a hit lies on: HitRecord::primitive and Hit::primitive_id.
     enum Surface : std::uint32_t { kSide = 0, kBottomCap = 1, kTopCap = 2 };
@@ -35,11 +36,12 @@ public:
     Aabb bounds() const override;
     bool is_solid() const override { return capped_; }
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
     bool contains(const Point3& p) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The nearest point in [t_min, t_max] where the ray meets the surface (the solid's span
+    /// ends when capped); `primitive` is the Surface.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     double radius() const { return radius_; }
     double y_min() const { return y_min_; }
@@ -47,7 +49,6 @@ public:
     bool capped() const { return capped_; }
 
 private:
-    bool nearest(const Ray& ray, double& t, std::uint32_t& surface) const;
 
     double radius_;
     double y_min_;
@@ -55,40 +56,7 @@ private:
     bool capped_;
 };
 
-namespace detail {
+extern template class detail::LeafShape<Cylinder>;
 
-/// The closed part [t0, t1] of a ray's line inside a solid, with the surface each end lies on.
-/// Either end may be infinite (not a crossing); an empty interval has t0 > t1.
-struct LineInterval {
-    double t0 = kInfinity;
-    double t1 = -kInfinity;
-    std::uint32_t surface0 = 0;
-    std::uint32_t surface1 = 0;
-
-    bool empty() const { return !(t0 <= t1); }
-};
-
-/// The ray's line inside the infinite solid cylinder x^2 + z^2 <= radius^2 (object space, any
-/// direction length); both ends are labelled `side`. Uses the cancellation-free quadratic after
-/// moving a far origin to the line's closest approach to the axis, so t keeps a relative error
-/// of a few ulps for origins millions of radii away.
-LineInterval infinite_cylinder_interval(const Ray& ray, double radius, std::uint32_t side);
-
-/// The ray's line between the planes y = lower and y = upper (lower <= upper), each end
-/// labelled with its plane's surface. A ray parallel to the planes is inside everywhere (the
-/// closed slab) or nowhere.
-LineInterval slab_interval(const Ray& ray, double lower, double upper, std::uint32_t lower_surface,
-                           std::uint32_t upper_surface);
-
-/// The overlap of two intervals: the later entry and the earlier exit, each with its surface;
-/// ties keep `a`'s surface.
-LineInterval overlap(const LineInterval& a, const LineInterval& b);
-
-/// The nearest point in [t_min, t_max] where the ray crosses the side of an open surface of
-/// revolution limited to `slab`: a finite end of `side` inside the slab, with its label.
-bool nearest_open_surface_hit(const Ray& ray, const LineInterval& side, const LineInterval& slab,
-                              double& t, std::uint32_t& surface);
-
-}  // namespace detail
 
 }  // namespace csgrt

@@ -1,7 +1,7 @@
 #pragma once
 
 #include "csgrt/core/plane.h"
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 
 namespace csgrt {
 
@@ -11,7 +11,7 @@ namespace csgrt {
 /// Conventions: the normal is the one given; the rim belongs to the disk; a ray parallel to
 /// the plane never hits it; uv = (r / radius, phi / 2 pi) with r the distance from the center
 /// and phi = atan2(x, z) in [0, 2 pi) measured in `frame()` (for normal +y, the y-up azimuth).
-class Disk final : public Shape {
+class Disk final : public detail::LeafShape<Disk> {
 public:
     /// Throws InvalidParameter unless center is finite, normal finite and non-zero and radius
     /// > 0 and finite.
@@ -20,9 +20,9 @@ public:
     std::string_view kind() const override { return "disk"; }
     Aabb bounds() const override;
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The point in [t_min, t_max] where the ray crosses the disk, if any.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     const Point3& center() const { return center_; }
     /// The unit normal.
@@ -31,11 +31,12 @@ public:
     const SurfaceFrame& frame() const { return frame_; }
 
 private:
-    bool crossing(const Ray& ray, double& t) const;
 
     Point3 center_;
     SurfaceFrame frame_;
     double radius_;
 };
+
+extern template class detail::LeafShape<Disk>;
 
 }  // namespace csgrt

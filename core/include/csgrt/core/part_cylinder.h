@@ -1,7 +1,7 @@
 #pragma once
 
 #include "csgrt/core/angle_range.h"
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 
 namespace csgrt {
 
@@ -16,7 +16,7 @@ namespace csgrt {
 /// uv: ((phi - phi_min) / (phi_max - phi_min), (y - y_min) / (y_max - y_min)), with phi taken
 /// in [phi_min, phi_min + 2 pi). A ray lying in the surface (parallel to the axis at exactly the
 /// radius) misses it, as it misses an open Cylinder.
-class PartCylinder final : public Shape {
+class PartCylinder final : public detail::LeafShape<PartCylinder> {
 public:
     /// Throws InvalidParameter unless radius > 0 and finite, y_min < y_max both finite, and the
     /// angles are as above.
@@ -26,9 +26,9 @@ public:
     /// The box of the arc (not of the whole cylinder), padded by a few ulps of the radius.
     Aabb bounds() const override { return bounds_; }
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The nearest point in [t_min, t_max] where the ray crosses the kept part of the side.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     double radius() const { return radius_; }
     double y_min() const { return y_min_; }
@@ -37,7 +37,6 @@ public:
     const AngleRange& azimuth() const { return azimuth_; }
 
 private:
-    bool nearest(const Ray& ray, double& t) const;
 
     double radius_;
     double y_min_;
@@ -45,5 +44,7 @@ private:
     AngleRange azimuth_;
     Aabb bounds_;
 };
+
+extern template class detail::LeafShape<PartCylinder>;
 
 }  // namespace csgrt

@@ -3,7 +3,7 @@
 #include <string_view>
 
 #include "csgrt/core/angle_range.h"
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 #include "csgrt/core/sphere.h"
 
 namespace csgrt {
@@ -16,7 +16,7 @@ namespace csgrt {
 /// removed part goes on to the far side; the normal points away from the center whichever side
 /// is hit; uv = (fraction of the azimuth range, (theta_max - theta) / (theta_max - theta_min)),
 /// so v grows upward as on the sphere.
-class PartSphere final : public Shape {
+class PartSphere final : public detail::LeafShape<PartSphere> {
 public:
     /// Throws InvalidParameter unless center is finite, radius > 0 and finite, the azimuth
     /// range follows AngleRange's rules and 0 <= theta_min < theta_max <= pi.
@@ -27,9 +27,9 @@ public:
     /// The box of the polar band (not trimmed by the azimuth range).
     Aabb bounds() const override;
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The nearest point in [t_min, t_max] where the ray crosses the kept part of the sphere.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     const Point3& center() const { return sphere_.center(); }
     double radius() const { return sphere_.radius(); }
@@ -45,7 +45,6 @@ public:
     }
 
 private:
-    bool first_crossing(const Ray& ray, double& t) const;
 
     Sphere sphere_;
     AngleRange azimuth_;
@@ -56,5 +55,7 @@ private:
     double y_low_;
     double y_high_;
 };
+
+extern template class detail::LeafShape<PartSphere>;
 
 }  // namespace csgrt

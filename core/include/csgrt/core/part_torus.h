@@ -18,7 +18,7 @@ namespace csgrt {
 /// crossing that is kept.
 ///
 /// uv = (fraction of the phi range, fraction of the theta range): [0, 1]^2 over the part.
-class PartTorus final : public Shape {
+class PartTorus final : public detail::LeafShape<PartTorus> {
 public:
     /// Throws InvalidParameter unless 0 < minor_radius < major_radius (both finite) and both
     /// ranges follow the rules above.
@@ -30,9 +30,9 @@ public:
     /// ulps of R + r.
     Aabb bounds() const override { return bounds_; }
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The nearest root in [t_min, t_max] whose surface point the angle limits keep.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     const Torus& torus() const { return torus_; }
 
@@ -47,5 +47,7 @@ private:
     AngleRange theta_range_;
     Aabb bounds_;
 };
+
+extern template class detail::LeafShape<PartTorus>;
 
 }  // namespace csgrt

@@ -1,62 +1,16 @@
 #pragma once
 
-#include <Eigen/Geometry>
-
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
+#include "csgrt/core/surface_frame.h"
 
 namespace csgrt {
-
-/// A right-handed orthonormal frame (x_axis, normal, z_axis) around a unit normal. The flat
-/// shapes measure uv and azimuth in it as y-up shapes do: local coordinates (x, y, z) =
-/// (p . x_axis, p . normal, p . z_axis) and phi = atan2(x, z).
-///
-/// For a normal with y >= 0 the frame is the world frame turned by the smallest rotation that
-/// takes +y to the normal (normal +y gives x_axis +x, z_axis +z); for y < 0 it is the world
-/// frame turned half a turn about z, then by the smallest rotation taking -y to the normal.
-/// The split keeps the formula's divisor >= 1 (the sign trick of Duff et al., "Building an
-/// Orthonormal Basis, Revisited", JCGT 6(1) 2017).
-struct SurfaceFrame {
-    Vector3 x_axis{1.0, 0.0, 0.0};
-    Normal3 normal{0.0, 1.0, 0.0};
-    Vector3 z_axis{0.0, 0.0, 1.0};
-
-    /// The frame of a unit normal (assumed unit length and finite).
-    static SurfaceFrame around(const Normal3& unit_normal);
-
-    /// World vector v in frame coordinates (x, y, z).
-    Vector3 to_local(const Vector3& v) const {
-        return Vector3(v.dot(x_axis), v.dot(normal), v.dot(z_axis));
-    }
-};
-
-namespace detail {
-
-/// v / |v|, computed after scaling by the largest component so tiny and huge vectors do not
-/// underflow or overflow; the zero vector for a zero or non-finite v.
-Vector3 normalized_or_zero(const Vector3& v);
-
-/// The parameter t where the ray's line crosses the plane through `point` with unit normal
-/// `normal`, t = (point - o) . n / (d . n). False when the ray is parallel to the plane (also
-/// when it lies in it: such a ray never crosses it) or t is not finite.
-inline bool plane_crossing(const Ray& ray, const Point3& point, const Normal3& normal, double& t) {
-    const double denominator = ray.direction.dot(normal);
-    if (denominator == 0.0) return false;
-    t = (point - ray.origin).dot(normal) / denominator;
-    return std::isfinite(t);
-}
-
-/// Conservative bounds of the disk of `radius` around `center` in the plane with unit normal
-/// `normal`: along axis i it reaches radius * sqrt(1 - n_i^2), rounded outward.
-Aabb disk_bounds(const Point3& center, const Normal3& normal, double radius);
-
-}  // namespace detail
 
 /// The infinite plane through `point` with normal `normal` (normalised). Not a solid.
 ///
 /// Conventions: the normal is the one given (not turned toward the ray); a ray parallel to the
 /// plane never hits it, even one lying in it; uv are the hit's coordinates along x_axis and
 /// z_axis of `frame()`, measured from `point`, wrapped into [0, 1) (one texture tile per unit).
-class Plane final : public Shape {
+class Plane final : public detail::LeafShape<Plane> {
 public:
     /// Throws InvalidParameter unless point is finite and normal finite and non-zero.
     Plane(const Point3& point, const Normal3& normal);
@@ -64,9 +18,9 @@ public:
     std::string_view kind() const override { return "plane"; }
     Aabb bounds() const override { return Aabb::infinite(); }
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The point in [t_min, t_max] where the ray crosses the plane, if any.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     const Point3& point() const { return point_; }
     /// The unit normal.
@@ -74,10 +28,11 @@ public:
     const SurfaceFrame& frame() const { return frame_; }
 
 private:
-    bool crossing(const Ray& ray, double& t) const;
 
     Point3 point_;
     SurfaceFrame frame_;
 };
+
+extern template class detail::LeafShape<Plane>;
 
 }  // namespace csgrt

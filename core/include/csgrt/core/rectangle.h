@@ -1,6 +1,6 @@
 #pragma once
 
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 
 namespace csgrt {
 
@@ -9,7 +9,7 @@ namespace csgrt {
 ///
 /// Conventions: edges and corners belong to it; a ray parallel to its plane never hits it; the
 /// normal is normalize(edge_a x edge_b); uv = (s, t), which the query keeps in HitRecord::u/v.
-class Rectangle final : public Shape {
+class Rectangle final : public detail::LeafShape<Rectangle> {
 public:
     /// Throws InvalidParameter unless corner and edges are finite, the edges non-zero and not
     /// parallel.
@@ -18,8 +18,6 @@ public:
     std::string_view kind() const override { return "rectangle"; }
     Aabb bounds() const override;
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
 
     const Point3& corner() const { return corner_; }
@@ -28,9 +26,9 @@ public:
     /// The unit normal.
     const Normal3& normal() const { return normal_; }
 
-    /// Whether the ray meets the parallelogram at some t in [t_min, t_max], with that t and the
-    /// hit's parameters (s, t) as `s` and `r`.
-    bool crossing(const Ray& ray, double& t, double& s, double& r) const;
+    /// Where the ray meets the parallelogram at some t in [t_min, t_max], with the hit's
+    /// parameters (s, t) as u and v.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
 private:
     Point3 corner_;
@@ -42,5 +40,7 @@ private:
     Vector3 dual_a_;
     Vector3 dual_b_;
 };
+
+extern template class detail::LeafShape<Rectangle>;
 
 }  // namespace csgrt

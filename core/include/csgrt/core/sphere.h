@@ -1,6 +1,6 @@
 #pragma once
 
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 
 namespace csgrt {
 
@@ -9,7 +9,7 @@ namespace csgrt {
 /// Parameterisation (as in Suffern, "Ray Tracing from the Ground Up", with y up): azimuth
 /// phi = atan2(x, z) in [0, 2 pi), polar angle theta = acos(y / r) in [0, pi] from +y;
 /// uv = (phi / 2 pi, 1 - theta / pi).
-class Sphere final : public Shape {
+class Sphere final : public detail::LeafShape<Sphere> {
 public:
     /// Throws InvalidParameter unless center is finite and radius > 0 and finite.
     Sphere(const Point3& center, double radius);
@@ -18,11 +18,11 @@ public:
     Aabb bounds() const override;
     bool is_solid() const override { return true; }
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
     bool contains(const Point3& p) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The nearest root of the ray's line with the sphere in [t_min, t_max], if any.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     const Point3& center() const { return center_; }
     double radius() const { return radius_; }
@@ -44,5 +44,7 @@ private:
     /// direction lengths in [2^-400, 2^400] stay normal doubles (the fast path of line_roots).
     bool moderate_;
 };
+
+extern template class detail::LeafShape<Sphere>;
 
 }  // namespace csgrt

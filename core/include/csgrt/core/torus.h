@@ -2,7 +2,7 @@
 
 #include <string_view>
 
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 #include "csgrt/core/sphere.h"
 
 namespace csgrt {
@@ -26,7 +26,7 @@ namespace csgrt {
 /// near-tangency as a double root, which is then decided by the well-conditioned tube function
 /// (rho - R)^2 + y^2 - r^2 along the original ray; every other root is polished on that same
 /// function in the original parameterisation, inside a bracket whose signs are verified.
-class Torus final : public Shape {
+class Torus final : public detail::LeafShape<Torus> {
 public:
     /// Throws InvalidParameter unless 0 < minor_radius < major_radius, both finite.
     Torus(double major_radius, double minor_radius);
@@ -35,11 +35,11 @@ public:
     Aabb bounds() const override;
     bool is_solid() const override { return true; }
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
     bool contains(const Point3& p) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// The nearest root of the ray's line with the torus in [t_min, t_max], if any.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
     double major_radius() const { return major_radius_; }
     double minor_radius() const { return minor_radius_; }
@@ -62,5 +62,7 @@ private:
     /// Encloses the torus with a margin, so the quartic is clearly positive where it is cut.
     Sphere bounding_sphere_;
 };
+
+extern template class detail::LeafShape<Torus>;
 
 }  // namespace csgrt

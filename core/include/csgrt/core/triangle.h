@@ -2,7 +2,7 @@
 
 #include <array>
 
-#include "csgrt/core/shape.h"
+#include "csgrt/core/leaf_shape.h"
 
 namespace csgrt {
 
@@ -16,7 +16,7 @@ namespace csgrt {
 /// grazing hit); the normal is normalize((p1 - p0) x (p2 - p0)) (counter-clockwise winding
 /// faces the viewer); uv are the barycentrics (b1, b2) of p1 and p2, which the query keeps in
 /// HitRecord::u/v.
-class Triangle final : public Shape {
+class Triangle final : public detail::LeafShape<Triangle> {
 public:
     /// Throws InvalidParameter unless the vertices are finite and not collinear.
     Triangle(const Point3& p0, const Point3& p1, const Point3& p2);
@@ -24,21 +24,21 @@ public:
     std::string_view kind() const override { return "triangle"; }
     Aabb bounds() const override;
 
-    bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
-    bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
     Hit finish(const Ray& ray, const HitRecord& record) const override;
 
     const Point3& vertex(int i) const { return vertices_[i]; }
     /// The unit normal.
     const Normal3& normal() const { return normal_; }
 
-    /// The watertight test: whether the ray meets the triangle at some t in [t_min, t_max],
-    /// with that t and the barycentrics b1, b2 of p1 and p2.
-    bool crossing(const Ray& ray, double& t, double& b1, double& b2) const;
+    /// The watertight test: where the ray meets the triangle at some t in [t_min, t_max], with
+    /// the barycentrics b1, b2 of p1 and p2 as u and v.
+    std::optional<Crossing> crossing(const Ray& ray) const;
 
 private:
     std::array<Point3, 3> vertices_;
     Normal3 normal_;
 };
+
+extern template class detail::LeafShape<Triangle>;
 
 }  // namespace csgrt
