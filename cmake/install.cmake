@@ -180,6 +180,10 @@ if(CSGRT_BUILD_TESTS)
             -D WORK_DIR=${PROJECT_BINARY_DIR}/install_test
             -P ${PROJECT_SOURCE_DIR}/tests/install/run_install_test.cmake)
     set_tests_properties(install.consumer_project PROPERTIES LABELS install TIMEOUT 600)
+    # The shared build is a second build of the libraries (minutes on CI's two cores): the
+    # release suite runs it; the sanitizer trees, which test the same CMake, leave it out.
+endif()
+if(CSGRT_BUILD_TESTS AND NOT CSGRT_SANITIZE AND NOT CSGRT_TSAN)
     add_test(NAME install.shared_libraries
         COMMAND ${CMAKE_COMMAND} ${CSGRT_INSTALL_TEST_ARGUMENTS}
             -D SOURCE_DIR=${PROJECT_SOURCE_DIR}
