@@ -27,21 +27,8 @@ struct Frame {
     const Scene& scene;
     const RenderSettings& settings;
     CameraFilm film;
-    double scene_magnitude;
     StrataGrid strata;
 };
-
-/// The largest coordinate magnitude of the scene's bounds and camera: the scale the shadow
-/// offset falls back to near the origin.
-double scene_magnitude(const Scene& scene) {
-    double magnitude = scene.camera().position.cwiseAbs().maxCoeff();
-    const Aabb& bounds = scene.bounds();
-    if (!bounds.is_empty() && bounds.is_finite()) {
-        magnitude = std::max(
-            {magnitude, bounds.lower.cwiseAbs().maxCoeff(), bounds.upper.cwiseAbs().maxCoeff()});
-    }
-    return magnitude;
-}
 
 Vector3 albedo_of(const Scene& scene, std::uint32_t object_id) {
     if (object_id >= scene.objects().size()) return Material{}.albedo;
@@ -66,7 +53,8 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
         return albedo * std::abs(shading.dot(view));
     }
 
-    const Point3 origin = offset_ray_origin(hit.point, geometric, frame.scene_magnitude);
+    // Sized by the precision of the surface hit, not by the scene's distance from the origin.
+    const Point3 origin = spawn_ray_origin(hit, geometric);
     Vector3 radiance = Vector3::Zero();
     for (const Light& light : frame.scene.lights()) {
         Vector3 to_light;
@@ -168,7 +156,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
     RenderResult result{Image(settings.width, settings.height), {}};
     const Frame frame{scene, settings,
                       CameraFilm(scene.camera(), double(settings.width) / settings.height),
-                      scene_magnitude(scene), strata_for(settings.samples_per_pixel)};
+                      strata_for(settings.samples_per_pixel)};
 
     const int tiles_x = (settings.width + settings.tile_size - 1) / settings.tile_size;
     const int tiles_y = (settings.height + settings.tile_size - 1) / settings.tile_size;
