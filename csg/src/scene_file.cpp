@@ -664,10 +664,20 @@ ShapePointer Loader::mesh(Fields& fields) {
     MeshConfig config;
     config.double_precision = fields.boolean("double_precision", false);
     config.accelerator = fields.string("accelerator", config.accelerator);
+    // Shading and welding (docs/scene-format.md): "flat", "crease_degrees" in (0, 180],
+    // "weld" (merge vertices at equal positions: a per-corner soup becomes a solid).
+    config.flat_shading = fields.boolean("flat", false);
+    const double crease_degrees = fields.number("crease_degrees", 180.0);
+    if (!(crease_degrees > 0.0 && crease_degrees <= 180.0))
+        fields.fail("crease_degrees", "expected an angle in (0, 180] degrees");
+    config.crease_angle = crease_degrees * kPi / 180.0;
+    config.weld_vertices = fields.boolean("weld", false);
     const std::filesystem::path file = source_.directory / path;
     const std::string key = file.lexically_normal().string() + "|" +
                             (config.double_precision ? "double" : "float") + "|" +
-                            config.accelerator;
+                            config.accelerator + "|" + (config.flat_shading ? "flat" : "smooth") +
+                            "|" + std::to_string(crease_degrees) + "|" +
+                            (config.weld_vertices ? "weld" : "");
     if (const auto found = meshes_.find(key); found != meshes_.end()) return found->second;
     ShapePointer loaded;
     try {

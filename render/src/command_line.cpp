@@ -201,28 +201,29 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
 
 /// Counts every shape in the tree under `shape` by kind(), descending through instances,
 /// booleans and compounds; a shape shared by several parents counts once per use. Meshes add
-/// their triangles to `triangles`.
+/// their triangles to `triangles`, and the closed ones (solids) count in `closed_meshes`.
 void count_kinds(const Shape& shape, std::map<std::string, std::size_t>& counts,
-                 std::size_t& triangles) {
+                 std::size_t& triangles, std::size_t& closed_meshes) {
     const std::string_view kind = shape.kind();
     ++counts[std::string(kind)];
     if (kind == "mesh") {
         if (const auto* mesh = dynamic_cast<const Mesh*>(&shape)) {
             triangles += mesh->triangle_count();
+            closed_meshes += mesh->report().is_closed ? 1 : 0;
         }
     } else if (kind == "instance") {
         if (const auto* instance = dynamic_cast<const Instance*>(&shape)) {
-            count_kinds(instance->shape(), counts, triangles);
+            count_kinds(instance->shape(), counts, triangles, closed_meshes);
         }
     } else if (kind == "union" || kind == "intersection" || kind == "difference") {
         if (const auto* node = dynamic_cast<const Boolean*>(&shape)) {
-            count_kinds(node->first(), counts, triangles);
-            count_kinds(node->second(), counts, triangles);
+            count_kinds(node->first(), counts, triangles, closed_meshes);
+            count_kinds(node->second(), counts, triangles, closed_meshes);
         }
     } else if (kind == "compound") {
         if (const auto* compound = dynamic_cast<const Compound*>(&shape)) {
             for (const auto& child : compound->children()) {
-                count_kinds(*child, counts, triangles);
+                count_kinds(*child, counts, triangles, closed_meshes);
             }
         }
     }
@@ -239,9 +240,9 @@ void info_command(const std::string& scene_path, CommandLineStreams streams) {
     Scene scene = load_checked(scene_path);
     scene.commit();  // "auto": what a render without --accel would build
     std::map<std::string, std::size_t> counts;
-    std::size_t unbounded = 0, triangles = 0;
+    std::size_t unbounded = 0, triangles = 0, closed_meshes = 0;
     for (const SceneObject& object : scene.objects()) {
-        count_kinds(*object.shape, counts, triangles);
+        count_kinds(*object.shape, counts, triangles, closed_meshes);
         if (!object.shape->bounds().is_finite()) ++unbounded;
     }
     std::size_t shapes = 0;
@@ -256,6 +257,10 @@ void info_command(const std::string& scene_path, CommandLineStreams streams) {
         out << row;
         if (kind == "mesh") out << " (" << triangles << " triangles in all)";
         out << '\n';
+    }
+    if (const auto meshes = counts.find("mesh"); meshes != counts.end()) {
+        out << "meshes:     " << closed_meshes << " closed (solids: CSG operands, inside/outside), "
+            << meshes->second - closed_meshes << " open\n";
     }
     std::size_t point_lights = 0;
     for (const Light& light : scene.lights())
