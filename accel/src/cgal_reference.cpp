@@ -154,8 +154,7 @@ std::optional<CgalReference::Answer> CgalReference::nearest(const Ray& ray) cons
         // A ray in the triangle's plane meets it in a segment: the near end, constructed
         // exactly. Otherwise the plane's t in long double.
         const std::optional<double> in_plane = in_plane_t(ray, primitive);
-        const double rounded =
-            in_plane ? *in_plane : static_cast<double>(plane_t(ray, primitive));
+        const double rounded = in_plane ? *in_plane : static_cast<double>(plane_t(ray, primitive));
         if (!best || rounded < best->t) best = Answer{rounded, primitive};
     }
     return best;

@@ -363,9 +363,9 @@ Hit Mesh::finish(const Ray& ray, const HitRecord& record) const {
     // Float triangles test a ray whose origin they round to float: the float margin, relative
     // to the corners (the point lies in their hull). Double ones get the double rule later.
     if (!double_precision_) {
-        hit.point_error = kFloatHitErrorRelative * std::max({a.cwiseAbs().maxCoeff(),
-                                                             b.cwiseAbs().maxCoeff(),
-                                                             c.cwiseAbs().maxCoeff()});
+        hit.point_error =
+            kFloatHitErrorRelative *
+            std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), c.cwiseAbs().maxCoeff()});
     }
     const Normal3 face = (b - a).cross(c - a);
     const std::array<std::uint32_t, 3>& t = triangles_[i];

@@ -1004,7 +1004,8 @@ public:
 /// scan. Points are 2D, counter-clockwise.
 class EarClipper {
 public:
-    EarClipper(const std::vector<Eigen::Vector2d>& points, std::vector<std::array<std::uint32_t, 3>>& out)
+    EarClipper(const std::vector<Eigen::Vector2d>& points,
+               std::vector<std::array<std::uint32_t, 3>>& out)
         : points_(points), out_(out), nodes_(points.size()) {
         const std::size_t n = points.size();
         Eigen::Vector2d lower = points[0], upper = points[0];
@@ -1260,7 +1261,8 @@ bool triangulate(std::span<const std::uint32_t> polygon,
     corners.reserve(n - 2);
     EarClipper clipper(points, corners);
     const std::vector<std::uint32_t> left = clipper.run();
-    for (const auto& t : corners) triangles.push_back({polygon[t[0]], polygon[t[1]], polygon[t[2]]});
+    for (const auto& t : corners)
+        triangles.push_back({polygon[t[0]], polygon[t[1]], polygon[t[2]]});
     if (left.size() < 3) return !clipper.cut_crossings();
     std::vector<std::uint32_t> rest;
     for (std::uint32_t i : left) rest.push_back(polygon[i]);

@@ -59,8 +59,7 @@ namespace {
 // that knows a larger one (a float mesh) has set it already.
 Hit finish_leaf(const Ray& ray, const HitRecord& record) {
     Hit hit = record.shape->finish(ray, record);
-    double magnitude =
-        std::max(hit.point.cwiseAbs().maxCoeff(), ray.origin.cwiseAbs().maxCoeff());
+    double magnitude = std::max(hit.point.cwiseAbs().maxCoeff(), ray.origin.cwiseAbs().maxCoeff());
     const Aabb bounds = record.shape->bounds();
     if (!bounds.is_empty() && bounds.is_finite()) {
         magnitude = std::max(

@@ -673,11 +673,10 @@ ShapePointer Loader::mesh(Fields& fields) {
     config.crease_angle = crease_degrees * kPi / 180.0;
     config.weld_vertices = fields.boolean("weld", false);
     const std::filesystem::path file = source_.directory / path;
-    const std::string key = file.lexically_normal().string() + "|" +
-                            (config.double_precision ? "double" : "float") + "|" +
-                            config.accelerator + "|" + (config.flat_shading ? "flat" : "smooth") +
-                            "|" + std::to_string(crease_degrees) + "|" +
-                            (config.weld_vertices ? "weld" : "");
+    const std::string key =
+        file.lexically_normal().string() + "|" + (config.double_precision ? "double" : "float") +
+        "|" + config.accelerator + "|" + (config.flat_shading ? "flat" : "smooth") + "|" +
+        std::to_string(crease_degrees) + "|" + (config.weld_vertices ? "weld" : "");
     if (const auto found = meshes_.find(key); found != meshes_.end()) return found->second;
     ShapePointer loaded;
     try {

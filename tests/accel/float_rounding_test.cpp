@@ -102,8 +102,8 @@ TEST(FloatRounding, EveryStructureGivesTheBitsOfTheTestWithEveryRoundingExplicit
     std::vector<std::array<std::uint32_t, 3>> triangles;
     for (int i = 0; i < 600; ++i) {
         const double scale = std::pow(10.0, random.uniform(-3.0, 3.0));
-        const Point3 centre = scale * Vector3(random.uniform(-1, 1), random.uniform(-1, 1),
-                                              random.uniform(-1, 1));
+        const Point3 centre =
+            scale * Vector3(random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1));
         const auto first = static_cast<std::uint32_t>(vertices.size());
         for (int k = 0; k < 3; ++k)
             vertices.push_back(centre + 0.05 * scale * random.unit_vector());
@@ -128,9 +128,9 @@ TEST(FloatRounding, EveryStructureGivesTheBitsOfTheTestWithEveryRoundingExplicit
         expected[r] = emulate_nearest(set, rays[r]);
         if (!expected[r]) continue;
         ++hits;
-        const std::optional<EmulatedHit> dropped =
-            emulate(set, expected[r]->first, rays[r], true);
-        if (!dropped || dropped->t != expected[r]->second.t || dropped->b1 != expected[r]->second.b1)
+        const std::optional<EmulatedHit> dropped = emulate(set, expected[r]->first, rays[r], true);
+        if (!dropped || dropped->t != expected[r]->second.t ||
+            dropped->b1 != expected[r]->second.b1)
             ++changed_by_a_dropped_rounding;
     }
     ASSERT_GT(hits, 2500);
@@ -157,8 +157,8 @@ TEST(FloatRounding, EveryStructureGivesTheBitsOfTheTestWithEveryRoundingExplicit
         std::printf("  | %s | %zu | %ld | %ld |\n", std::string(name).c_str(), rays.size(),
                     structure_hits, same);
     }
-    std::printf("  | (the shear's product rounding dropped) | %zu | %ld | %ld |\n",
-                rays.size(), hits, hits - changed_by_a_dropped_rounding);
+    std::printf("  | (the shear's product rounding dropped) | %zu | %ld | %ld |\n", rays.size(),
+                hits, hits - changed_by_a_dropped_rounding);
 }
 
 }  // namespace

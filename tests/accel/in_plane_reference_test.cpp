@@ -83,8 +83,8 @@ void check_structures(const char* precision) {
             ++reference_wrong;
             ADD_FAILURE() << "reference t " << exact->t << ", exact " << planar.t << " for o ("
                           << planar.ray.origin.transpose() << ") d ("
-                          << planar.ray.direction.transpose() << ") [" << planar.ray.t_min
-                          << ", " << planar.ray.t_max << "]";
+                          << planar.ray.direction.transpose() << ") [" << planar.ray.t_min << ", "
+                          << planar.ray.t_max << "]";
         }
     }
     for (const std::string_view name : accelerator_names()) {
@@ -101,14 +101,13 @@ void check_structures(const char* precision) {
             }
             ++hits;
             // Integer coordinates and axis-aligned rays: every product is exact, so is t.
-            EXPECT_EQ(record.t, planar.t)
-                << name << " o (" << planar.ray.origin.transpose() << ") d ("
-                << planar.ray.direction.transpose() << ") [" << planar.ray.t_min << ", "
-                << planar.ray.t_max << "]";
+            EXPECT_EQ(record.t, planar.t) << name << " o (" << planar.ray.origin.transpose()
+                                          << ") d (" << planar.ray.direction.transpose() << ") ["
+                                          << planar.ray.t_min << ", " << planar.ray.t_max << "]";
             if (record.t == planar.t) ++agreeing;
         }
-        std::printf("  | %s | %ld | %ld | %ld | %ld |\n", std::string(name).c_str(),
-                    hits + misses, hits, agreeing, misses);
+        std::printf("  | %s | %ld | %ld | %ld | %ld |\n", std::string(name).c_str(), hits + misses,
+                    hits, agreeing, misses);
         // Rays along faces (not edges) meet the perpendicular face inside one of its edges,
         // which exactly one of the two triangles there owns: most rays hit.
         EXPECT_GT(hits, misses) << name;

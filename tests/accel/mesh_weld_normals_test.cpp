@@ -59,7 +59,8 @@ TEST(WeldVertices, TheMeshOptionWeldsAPlyWrittenPerCornerIntoASolid) {
             << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
             << soup.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
         for (const auto& v : soup.vertices) out << v.x() << " " << v.y() << " " << v.z() << "\n";
-        for (const auto& t : soup.triangles) out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+        for (const auto& t : soup.triangles)
+            out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
     }
     const auto open = Mesh::load(path);
     EXPECT_FALSE(open->is_solid());
@@ -103,9 +104,10 @@ TEST(SmoothShading, TheShadingNormalIsTheBarycentricInterpolationOfTheVertexNorm
         const long double area = n.squaredNorm();
         const long double u = (p - a).cross(c - a).dot(n) / area;  // weight of b
         const long double v = (b - a).cross(p - a).dot(n) / area;  // weight of c
-        LongVector expected = (1.0L - u - v) * validated.normals[t[0]].cast<float>().cast<long double>() +
-                              u * validated.normals[t[1]].cast<float>().cast<long double>() +
-                              v * validated.normals[t[2]].cast<float>().cast<long double>();
+        LongVector expected =
+            (1.0L - u - v) * validated.normals[t[0]].cast<float>().cast<long double>() +
+            u * validated.normals[t[1]].cast<float>().cast<long double>() +
+            v * validated.normals[t[2]].cast<float>().cast<long double>();
         expected.normalize();
         // The mesh keeps the barycentrics in float (2^-24 relative) and the normals in float:
         // the interpolated unit vector is good to a few 1e-7; 1e-5 leaves room and still sees

@@ -87,8 +87,8 @@ Polygon comb(int teeth, int collinear) {
         }
     }
     // The base's corners at width k / (collinear + 1) are integers only for these counts.
-    return from_loop("comb of " + std::to_string(teeth) + " teeth, " +
-                         std::to_string(collinear) + " collinear corners",
+    return from_loop("comb of " + std::to_string(teeth) + " teeth, " + std::to_string(collinear) +
+                         " collinear corners",
                      loop);
 }
 
@@ -112,9 +112,10 @@ Polygon spiral(int turns) {
                 k + 1 < centre.size() ? Eigen::Vector2d((centre[k + 1] - centre[k]).normalized())
                                       : in;
             const Eigen::Vector2d along = k == 0 ? out : in;
-            line.push_back(centre[k] + half_width * (right(along) + (k == 0 || k + 1 == centre.size()
-                                                                         ? Eigen::Vector2d(0, 0)
-                                                                         : right(out))));
+            line.push_back(centre[k] +
+                           half_width * (right(along) + (k == 0 || k + 1 == centre.size()
+                                                             ? Eigen::Vector2d(0, 0)
+                                                             : right(out))));
         }
         return line;
     };
@@ -150,8 +151,7 @@ Polygon round_with_midpoints(int half) {
         loop.push_back(p);
         loop.push_back(0.5 * (p + q));
     }
-    return from_loop("circle with " + std::to_string(2 * half) + " corners, half collinear",
-                     loop);
+    return from_loop("circle with " + std::to_string(2 * half) + " corners, half collinear", loop);
 }
 
 /// Writes the polygon as one face in `format`, in the plane z = 0 or (tilted) x = 0.
@@ -159,6 +159,7 @@ std::filesystem::path write(const Polygon& polygon, const std::string& format, b
                             const std::filesystem::path& folder) {
     const std::filesystem::path path = folder / ("polygon." + format);
     std::ofstream out(path);
+    out.precision(17);  // integers up to 10^7: every digit
     auto point = [&](const Eigen::Vector2d& p) {
         if (tilted) {
             out << "0 " << p.x() << " " << p.y() << "\n";
@@ -196,9 +197,10 @@ std::filesystem::path write(const Polygon& polygon, const std::string& format, b
 class PolygonTriangulation : public ::testing::Test {
 protected:
     void SetUp() override {
-        folder_ = std::filesystem::temp_directory_path() /
-                  ("csgrt_polygons_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                   "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        folder_ =
+            std::filesystem::temp_directory_path() /
+            ("csgrt_polygons_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+             "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
         std::filesystem::create_directories(folder_);
     }
     void TearDown() override { std::filesystem::remove_all(folder_); }
@@ -207,9 +209,16 @@ protected:
 
 TEST_F(PolygonTriangulation, TrianglesCoverExactlyThePolygonInEveryFormat) {
     const std::vector<Polygon> polygons = {
-        keyhole(1),  keyhole(3),        comb(5, 0),           comb(40, 9),
-        spiral(9),   spiral(40),        collinear_square(50), collinear_square(2500),
-        comb(2500, 0), round_with_midpoints(50000),
+        keyhole(1),
+        keyhole(3),
+        comb(5, 0),
+        comb(40, 9),
+        spiral(9),
+        spiral(40),
+        collinear_square(50),
+        collinear_square(2500),
+        comb(2500, 0),
+        round_with_midpoints(50000),
     };
     std::printf("\n  | polygon | corners | format | triangles | exact area | triangles' area |\n");
     for (const Polygon& polygon : polygons) {
@@ -227,8 +236,8 @@ TEST_F(PolygonTriangulation, TrianglesCoverExactlyThePolygonInEveryFormat) {
                 }
                 // Integer coordinates below 2^24 (exact in float), products below 2^53: the
                 // norm of an axis-aligned normal is exact, and so is the sum.
-                EXPECT_EQ(area, expected) << polygon.name << " as " << format
-                                          << (tilted ? " (tilted)" : "");
+                EXPECT_EQ(area, expected)
+                    << polygon.name << " as " << format << (tilted ? " (tilted)" : "");
                 EXPECT_EQ(report.non_simple_faces, 0u) << polygon.name << " as " << format;
                 EXPECT_EQ(report.triangulated_faces, 1u);
                 if (!tilted) {

@@ -45,8 +45,9 @@ TEST(SceneMeshKeys, FlatAndCreaseShadeWithTheFaceAndSmoothDoesNot) {
 
 TEST(SceneMeshKeys, ACreaseOutsideItsRangeIsAnErrorAtTheKey) {
     for (const char* value : {"0", "-5", "181", "true"}) {
-        const std::string text = std::string(R"({"objects": [{"type": "mesh", "path": "box.off", )") +
-                                 R"("crease_degrees": )" + value + "}]}";
+        const std::string text =
+            std::string(R"({"objects": [{"type": "mesh", "path": "box.off", )") +
+            R"("crease_degrees": )" + value + "}]}";
         try {
             load_scene_from_string(text, "test.json", kMeshes);
             ADD_FAILURE() << "accepted crease_degrees " << value;

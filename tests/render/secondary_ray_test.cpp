@@ -89,13 +89,13 @@ std::vector<Subject> subjects(const Point3& place, double size) {
                     true});
     list.push_back(
         {"torus (instance)", instance(std::make_shared<Torus>(1.0, 0.25), placement), false});
-    list.push_back({"part_sphere",
-                    std::make_shared<PartSphere>(place, size, 1.0, 5.0, 0.5, 2.5), false});
+    list.push_back(
+        {"part_sphere", std::make_shared<PartSphere>(place, size, 1.0, 5.0, 0.5, 2.5), false});
     list.push_back({"part_cylinder (instance)",
                     instance(std::make_shared<PartCylinder>(1.0, -1.0, 1.0, 0.5, 4.0), placement),
                     false});
-    auto box = std::make_shared<Box>(place - size * Vector3(1, 1, 1),
-                                     place + size * Vector3(1, 1, 1));
+    auto box =
+        std::make_shared<Box>(place - size * Vector3(1, 1, 1), place + size * Vector3(1, 1, 1));
     auto bite = std::make_shared<Sphere>(place + size * Vector3(1, 1, 1), size);
     list.push_back({"box - sphere (CSG)", make_difference(box, {bite}), false});
     for (const bool double_precision : {false, true}) {
@@ -104,8 +104,7 @@ std::vector<Subject> subjects(const Point3& place, double size) {
                         mesh_at(test::sphere_mesh(3), placement, double_precision), true});
         list.push_back(
             {"sphere_mesh(3)" + precision + " (instance)",
-             instance(mesh_at(test::sphere_mesh(3), Transform(), double_precision),
-                      sheared),
+             instance(mesh_at(test::sphere_mesh(3), Transform(), double_precision), sheared),
              true});
     }
     return list;
@@ -136,10 +135,9 @@ TEST(SecondaryRays, NeverRehitTheSurfaceTheyLeaveWhereverTheSceneIs) {
             long rays_here = 0, hits_here = 0;
             for (const Subject& subject : subjects(place, size)) {
                 const Shape& shape = *subject.shape;
-                const Aabb box = shape.bounds().is_finite()
-                                     ? shape.bounds()
-                                     : Aabb(place - Vector3::Constant(size),
-                                            place + Vector3::Constant(size));
+                const Aabb box = shape.bounds().is_finite() ? shape.bounds()
+                                                            : Aabb(place - Vector3::Constant(size),
+                                                                   place + Vector3::Constant(size));
                 const Point3 camera = place + 6.0 * size * Vector3(0.3, 0.5, -0.8);
                 for (int i = 0; i < 150; ++i) {
                     const Ray primary{camera, random.in_box(box) - camera};
@@ -169,10 +167,10 @@ TEST(SecondaryRays, NeverRehitTheSurfaceTheyLeaveWhereverTheSceneIs) {
                             ++self_hits[f];
                             if (f == 0) {
                                 ++hits_here;
-                                ADD_FAILURE() << subject.name << " at " << translation
-                                              << ", size " << size << ": re-hit at distance "
-                                              << again->t * direction.norm() << " (error "
-                                              << hit->point_error << ")";
+                                ADD_FAILURE()
+                                    << subject.name << " at " << translation << ", size " << size
+                                    << ": re-hit at distance " << again->t * direction.norm()
+                                    << " (error " << hit->point_error << ")";
                             }
                         }
                     }
@@ -186,7 +184,6 @@ TEST(SecondaryRays, NeverRehitTheSurfaceTheyLeaveWhereverTheSceneIs) {
     EXPECT_EQ(self_hits[0], 0);
     EXPECT_GT(leaving_rays, 20000);
 }
-
 
 /// The largest coordinate magnitude of the scene's bounds and camera: what the renderer's
 /// former offset (offset_ray_origin, 2^-16 of it near the origin) was sized by.
@@ -257,8 +254,9 @@ TEST(SecondaryRays, AMovedSceneShadowsTheSamePixelsAndKeepsItsThinGaps) {
     // The three thin objects cast shadows on the floor at the origin (independently of any
     // offset: 0.002 is 10^9 of the point error there).
     ASSERT_GT(shadowed_floor, 100);
-    std::printf("\n  | translation | pixels whose lit/shadowed state differs from the origin's:"
-                " former offset | point-error offset (renderer) |\n");
+    std::printf(
+        "\n  | translation | pixels whose lit/shadowed state differs from the origin's:"
+        " former offset | point-error offset (renderer) |\n");
     for (const double translation : kTranslations) {
         const Scene moved = thin_gaps(translation * kShiftDirection);
         const RenderResult result = render(moved, settings);
@@ -391,8 +389,9 @@ TEST(SecondaryRays, GrazingLightInAConcaveCavityMatchesALongDoubleReference) {
     settings.width = 48;
     settings.height = 48;
     settings.threads = 1;
-    std::printf("\n  | translation | pixels | lit | dark | ambiguous (within 1e-9) |"
-                " disagreements: former offset | point-error offset (renderer) |\n");
+    std::printf(
+        "\n  | translation | pixels | lit | dark | ambiguous (within 1e-9) |"
+        " disagreements: former offset | point-error offset (renderer) |\n");
     for (const double translation : {0.0, 1e4}) {
         // The reference is computed for the scene at the origin with the moved scene's rays
         // moved back: the same geometry, exactly.
@@ -400,8 +399,8 @@ TEST(SecondaryRays, GrazingLightInAConcaveCavityMatchesALongDoubleReference) {
         Scene scene;
         auto box = std::make_shared<Box>(shift + cavity.lower.cast<double>(),
                                          shift + cavity.upper.cast<double>());
-        auto ball = std::make_shared<Sphere>(shift + cavity.centre.cast<double>(),
-                                             double(cavity.radius));
+        auto ball =
+            std::make_shared<Sphere>(shift + cavity.centre.cast<double>(), double(cavity.radius));
         scene.add_object(make_difference(box, {ball}), 0, "dish");
         scene.add_light(PointLight{shift + cavity.light, Vector3(10, 10, 10)});
         Camera camera;
@@ -431,9 +430,8 @@ TEST(SecondaryRays, GrazingLightInAConcaveCavityMatchesALongDoubleReference) {
                 (expected_lit ? lit : dark) += 1;
                 if ((pixel.red > 0.0f) != expected_lit) {
                     ++wrong;
-                    ADD_FAILURE() << "pixel " << x << ", " << y << " at translation "
-                                  << translation << ": expected "
-                                  << (expected_lit ? "lit" : "dark");
+                    ADD_FAILURE() << "pixel " << x << ", " << y << " at translation " << translation
+                                  << ": expected " << (expected_lit ? "lit" : "dark");
                 }
                 const std::optional<bool> before = lit_with_former_offset(scene, ray);
                 if (before.has_value() && *before != expected_lit) ++wrong_before;
