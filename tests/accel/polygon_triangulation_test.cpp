@@ -19,6 +19,7 @@
 
 #include "csgrt/accel/mesh_io.h"
 #include "csgrt/core/math.h"
+#include "support/test_scale.h"
 
 namespace csgrt {
 namespace {
@@ -207,19 +208,9 @@ protected:
     std::filesystem::path folder_;
 };
 
-TEST_F(PolygonTriangulation, TrianglesCoverExactlyThePolygonInEveryFormat) {
-    const std::vector<Polygon> polygons = {
-        keyhole(1),
-        keyhole(3),
-        comb(5, 0),
-        comb(40, 9),
-        spiral(9),
-        spiral(40),
-        collinear_square(50),
-        collinear_square(2500),
-        comb(2500, 0),
-        round_with_midpoints(50000),
-    };
+/// Loads each polygon as one face in every format and both planes, and checks that the
+/// triangles cover exactly its area.
+void check_areas(const std::vector<Polygon>& polygons, const std::filesystem::path& folder) {
     std::printf("\n  | polygon | corners | format | triangles | exact area | triangles' area |\n");
     for (const Polygon& polygon : polygons) {
         const double expected = 0.5 * twice_area(polygon);
@@ -228,7 +219,7 @@ TEST_F(PolygonTriangulation, TrianglesCoverExactlyThePolygonInEveryFormat) {
             for (const bool tilted : {false, true}) {
                 MeshReport report;
                 const TriangleMeshData mesh =
-                    load_mesh(write(polygon, format, tilted, folder_), &report);
+                    load_mesh(write(polygon, format, tilted, folder), &report);
                 double area = 0.0;
                 for (const auto& t : mesh.triangles) {
                     const Eigen::Vector3d& a = mesh.vertices[t[0]];
@@ -248,6 +239,20 @@ TEST_F(PolygonTriangulation, TrianglesCoverExactlyThePolygonInEveryFormat) {
             }
         }
     }
+}
+
+TEST_F(PolygonTriangulation, TrianglesCoverExactlyThePolygonInEveryFormat) {
+    check_areas({keyhole(1), keyhole(3), comb(5, 0), comb(40, 9), spiral(9), spiral(40),
+                 collinear_square(50)},
+                folder_);
+}
+
+TEST_F(PolygonTriangulation, HeavyLargeFacesCoverExactlyThePolygonInEveryFormat) {
+    // Label "heavy" (the name): about 10 s in a release build. The sanitizer build takes
+    // test::scaled() of the sizes.
+    check_areas({collinear_square(test::scaled(2500, 50)), comb(test::scaled(2500, 40), 0),
+                 round_with_midpoints(test::scaled(50000, 500))},
+                folder_);
 }
 
 TEST_F(PolygonTriangulation, ASelfIntersectingFaceIsCountedAsNotSimple) {
