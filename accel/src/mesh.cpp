@@ -6,6 +6,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "csgrt/accel/mesh_tools.h"
 #include "csgrt/core/error.h"
 
 namespace csgrt {
@@ -93,10 +94,67 @@ const std::array<Vector3, 5>& membership_directions() {
     return directions;
 }
 
+/// Incident triangles per vertex above which creased corner normals are not computed (the
+/// corner takes its face's normal): the pairwise comparison costs the square of the count.
+constexpr std::size_t kMaxCreaseFan = 1024;
+
+/// Per-corner normals split at creases (MeshConfig::crease_angle): for corner k of triangle i
+/// at vertex v, the sum over the triangles at v whose normal is within the angle of triangle
+/// i's, of their unit normal times their angle at v (the weights of validate_mesh's vertex
+/// normals, Thuermer and Wuethrich 1998), normalised.
+std::vector<std::array<Eigen::Vector3f, 3>> crease_normals(
+    const std::vector<Eigen::Vector3d>& vertices,
+    const std::vector<std::array<std::uint32_t, 3>>& triangles, double crease_angle) {
+    const std::size_t n = triangles.size();
+    std::vector<Eigen::Vector3d> face(n);
+    std::vector<std::array<double, 3>> angle(n);
+    std::vector<std::uint32_t> start(vertices.size() + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto& t = triangles[i];
+        face[i] = (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]);
+        face[i].normalize();
+        for (int k = 0; k < 3; ++k) {
+            const Eigen::Vector3d to_next = vertices[t[(k + 1) % 3]] - vertices[t[k]];
+            const Eigen::Vector3d to_previous = vertices[t[(k + 2) % 3]] - vertices[t[k]];
+            angle[i][k] = std::atan2(to_next.cross(to_previous).norm(), to_next.dot(to_previous));
+            ++start[t[k] + 1];
+        }
+    }
+    for (std::size_t v = 0; v < vertices.size(); ++v) start[v + 1] += start[v];
+    // The corners at each vertex, as 3 i + k.
+    std::vector<std::uint32_t> corners(3 * n);
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k) corners[fill[triangles[i][k]]++] = std::uint32_t(3 * i + k);
+    }
+    const double cos_crease = std::cos(crease_angle);
+    std::vector<std::array<Eigen::Vector3f, 3>> normals(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = triangles[i][k];
+            Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+            if (start[v + 1] - start[v] > kMaxCreaseFan) {
+                sum = face[i];
+            } else {
+                for (std::uint32_t c = start[v]; c < start[v + 1]; ++c) {
+                    const std::uint32_t other = corners[c] / 3, at = corners[c] % 3;
+                    if (face[other].dot(face[i]) >= cos_crease)
+                        sum += angle[other][at] * face[other];
+                }
+            }
+            const double length = sum.norm();
+            normals[i][k] = (length > 0.0 ? Eigen::Vector3d(sum / length) : face[i]).cast<float>();
+        }
+    }
+    return normals;
+}
+
 }  // namespace
 
 Mesh::Mesh(TriangleMeshData mesh, const MeshConfig& config) {
+    const std::size_t welded = config.weld_vertices ? weld_vertices(mesh) : 0;
     MeshReport report = validate_mesh(mesh);
+    report.welded_vertices = welded;
     build(std::move(mesh), std::move(report), config);
 }
 
@@ -109,6 +167,19 @@ Mesh::~Mesh() = default;
 std::shared_ptr<Mesh> Mesh::load(const std::filesystem::path& path, const MeshConfig& config) {
     MeshReport report;
     TriangleMeshData mesh = load_mesh(path, &report);
+    if (config.weld_vertices) {
+        // Validated again on the welded mesh: its topology (closed or not) is what changes.
+        const std::size_t welded = weld_vertices(mesh);
+        MeshReport topology = validate_mesh(mesh);
+        topology.format = report.format;
+        topology.binary = report.binary;
+        topology.faces = report.faces;
+        topology.dropped_faces = report.dropped_faces;
+        topology.triangulated_faces = report.triangulated_faces;
+        topology.non_simple_faces = report.non_simple_faces;
+        topology.welded_vertices = welded;
+        report = std::move(topology);
+    }
     return std::shared_ptr<Mesh>(new Mesh(std::move(mesh), std::move(report), config, Validated{}));
 }
 
@@ -118,6 +189,10 @@ void Mesh::build(TriangleMeshData mesh, MeshReport report, const MeshConfig& con
     triangles_ = std::move(mesh.triangles);
     normals_.reserve(mesh.normals.size());
     for (const Eigen::Vector3d& normal : mesh.normals) normals_.push_back(normal.cast<float>());
+    flat_shading_ = config.flat_shading;
+    if (!flat_shading_ && config.crease_angle < kPi) {
+        corner_normals_ = crease_normals(mesh.vertices, triangles_, config.crease_angle);
+    }
     if (double_precision_) {
         double_set_ = TriangleSet<double>(mesh.vertices, triangles_);
         double_structure_ =
@@ -285,10 +360,23 @@ Hit Mesh::finish(const Ray& ray, const HitRecord& record) const {
     hit.t = record.t;
     // From the barycentrics rather than o + t d: the point lies on the triangle.
     hit.point = w * a + u * b + v * c;
+    // Float triangles test a ray whose origin they round to float: the float margin, relative
+    // to the corners (the point lies in their hull). Double ones get the double rule later.
+    if (!double_precision_) {
+        hit.point_error =
+            kFloatHitErrorRelative *
+            std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), c.cwiseAbs().maxCoeff()});
+    }
     const Normal3 face = (b - a).cross(c - a);
     const std::array<std::uint32_t, 3>& t = triangles_[i];
-    const Normal3 smooth = w * normals_[t[0]].cast<double>() + u * normals_[t[1]].cast<double>() +
-                           v * normals_[t[2]].cast<double>();
+    // The vertex normals (or the creased corner normals) interpolated by the barycentrics.
+    const Normal3 smooth =
+        corner_normals_.empty()
+            ? Normal3(w * normals_[t[0]].cast<double>() + u * normals_[t[1]].cast<double>() +
+                      v * normals_[t[2]].cast<double>())
+            : Normal3(w * corner_normals_[i][0].cast<double>() +
+                      u * corner_normals_[i][1].cast<double>() +
+                      v * corner_normals_[i][2].cast<double>());
     const double face_length = face.norm();
     const double smooth_length = smooth.norm();
     // A triangle that rounding to float made degenerate has no normal of its own; it borrows
@@ -300,7 +388,7 @@ Hit Mesh::finish(const Ray& ray, const HitRecord& record) const {
     } else {
         hit.geometric_normal = -ray.direction.normalized();
     }
-    hit.shading_normal = smooth_length > 0.0 && std::isfinite(smooth_length)
+    hit.shading_normal = !flat_shading_ && smooth_length > 0.0 && std::isfinite(smooth_length)
                              ? Normal3(smooth / smooth_length)
                              : hit.geometric_normal;
     hit.uv = Vector2(u, v);

@@ -21,6 +21,8 @@
 #include <streambuf>
 #include <string_view>
 #include <system_error>
+#include <unordered_set>
+#include <vector>
 
 #include "csgrt/core/error.h"
 #include "openmesh_session.h"
@@ -178,6 +180,12 @@ struct Expectation {
     std::uint64_t corners = 0;
     std::uint64_t index_sum = 0;
     bool corners_known = true;
+    /// OBJ: every face's corners as written (0-based, repeats kept), flattened, and where each
+    /// face starts. OpenMesh's OBJ reader keeps only the first occurrence of a repeated corner,
+    /// which closes the hole of a keyhole polygon (the outer loop, a bridge, the hole, the
+    /// bridge back), so OBJ faces are triangulated as written.
+    std::vector<long long> written_corners;
+    std::vector<std::size_t> written_starts;
 };
 
 /// Adds one face (corner indices already validated) to the checksums. `distinct_only` mirrors
@@ -190,14 +198,13 @@ void expect_face(Expectation& expect, std::span<const long long> corners, bool d
         for (long long index : corners) expect.index_sum += static_cast<std::uint64_t>(index);
         return;
     }
-    std::size_t kept = 0;
+    // The distinct corners by sorting: a face of 10^5 corners costs a sort, not 10^10 finds.
+    std::vector<long long> distinct(corners.begin(), corners.end());
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    const std::size_t kept = distinct.size();
     std::uint64_t sum = 0;
-    for (std::size_t i = 0; i < corners.size(); ++i) {
-        if (std::find(corners.begin(), corners.begin() + i, corners[i]) != corners.begin() + i)
-            continue;
-        ++kept;
-        sum += static_cast<std::uint64_t>(corners[i]);
-    }
+    for (long long index : distinct) sum += static_cast<std::uint64_t>(index);
     if (kept < 3) {
         ++expect.dropped_faces;
         return;
@@ -419,6 +426,9 @@ Expectation scan_obj(std::istream& in) {
                 corners.push_back(parts[0]);
             }
             expect_face(expect, corners, true);
+            expect.written_starts.push_back(expect.written_corners.size());
+            expect.written_corners.insert(expect.written_corners.end(), corners.begin(),
+                                          corners.end());
             ++face;
         }
     }
@@ -1025,16 +1035,241 @@ public:
 
 // Triangulation
 
-/// Splits a polygon into triangles by ear clipping in the plane of its Newell normal, keeping
-/// its winding (Eberly, "Triangulation by Ear Clipping", 2002). A polygon that has no ear
-/// (self-intersecting, or collapsed) falls back to a fan; its degenerate triangles are then
-/// dropped by validation.
-void triangulate(std::span<const std::uint32_t> polygon,
+/// Ear clipping over a doubly linked ring of a polygon's corners, with the ear test limited to
+/// the corners near the ear by a z-order (Morton) index, after Mapbox's earcut (Agafonkin,
+/// https://github.com/mapbox/earcut, 2016; Eberly, "Triangulation by Ear Clipping", 2002 for
+/// the method). A corner that blocks an ear must be reflex and inside it; a corner at the same
+/// place as the ear's first corner does not block it, so a keyhole polygon (the outer loop, a
+/// bridge, the hole and the bridge back, with the bridge's corners repeated) is clipped around
+/// its hole. The corners looked at per ear are those whose Morton codes lie within the ear's
+/// box, so polygons of 10^5 corners take milliseconds instead of the minutes of the quadratic
+/// scan. Points are 2D, counter-clockwise.
+class EarClipper {
+public:
+    EarClipper(const std::vector<Eigen::Vector2d>& points,
+               std::vector<std::array<std::uint32_t, 3>>& out)
+        : points_(points), out_(out), nodes_(points.size()) {
+        const std::size_t n = points.size();
+        Eigen::Vector2d lower = points[0], upper = points[0];
+        for (const Eigen::Vector2d& p : points) {
+            lower = lower.cwiseMin(p);
+            upper = upper.cwiseMax(p);
+        }
+        lower_ = lower;
+        const double size = (upper - lower).maxCoeff();
+        inverse_size_ = size > 0.0 && std::isfinite(size) ? 32767.0 / size : 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            Node& node = nodes_[i];
+            node.prev = static_cast<int>((i + n - 1) % n);
+            node.next = static_cast<int>((i + 1) % n);
+            node.z = morton(points[i]);
+        }
+        // The z-order list: every corner sorted by Morton code.
+        std::vector<int> order(n);
+        for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<int>(i);
+        std::sort(order.begin(), order.end(),
+                  [&](int a, int b) { return nodes_[a].z < nodes_[b].z; });
+        for (std::size_t k = 0; k < n; ++k) {
+            nodes_[order[k]].prev_z = k > 0 ? order[k - 1] : -1;
+            nodes_[order[k]].next_z = k + 1 < n ? order[k + 1] : -1;
+        }
+    }
+
+    /// Clips the ring; returns the corners left when no ear and no local fix remains (empty
+    /// when the whole polygon was triangulated).
+    std::vector<std::uint32_t> run() {
+        std::vector<std::uint32_t> left;
+        int ear = 0;
+        int stop = ear;
+        int pass = 0;
+        while (nodes_[ear].prev != nodes_[ear].next) {
+            const int prev = nodes_[ear].prev, next = nodes_[ear].next;
+            if (is_ear(ear)) {
+                emit(prev, ear, next);
+                remove(ear);
+                ear = nodes_[next].next;
+                stop = ear;
+                continue;
+            }
+            ear = next;
+            if (ear != stop) continue;
+            // A whole round without an ear: drop repeated and collinear corners, then cut off
+            // locally self-intersecting pieces (earcut's passes 1 and 2); then give up.
+            if (pass == 0) {
+                ear = filter(ear);
+            } else if (pass == 1) {
+                ear = filter(cure_local_intersections(filter(ear)));
+            } else {
+                int p = ear;
+                do {
+                    left.push_back(static_cast<std::uint32_t>(p));
+                    p = nodes_[p].next;
+                } while (p != ear);
+                break;
+            }
+            ++pass;
+            stop = ear;
+            if (ear < 0) break;
+        }
+        return left;
+    }
+
+private:
+    struct Node {
+        int prev = -1, next = -1, prev_z = -1, next_z = -1;
+        std::uint32_t z = 0;
+    };
+
+    /// Twice the signed area of (a, b, c): positive when counter-clockwise.
+    double cross(int a, int b, int c) const {
+        const Eigen::Vector2d &pa = points_[a], &pb = points_[b], &pc = points_[c];
+        return (pb.x() - pa.x()) * (pc.y() - pa.y()) - (pb.y() - pa.y()) * (pc.x() - pa.x());
+    }
+    bool same_place(int a, int b) const { return points_[a] == points_[b]; }
+
+    std::uint32_t morton(const Eigen::Vector2d& p) const {
+        auto spread = [](std::uint32_t v) {
+            v = (v | (v << 8)) & 0x00FF00FFu;
+            v = (v | (v << 4)) & 0x0F0F0F0Fu;
+            v = (v | (v << 2)) & 0x33333333u;
+            v = (v | (v << 1)) & 0x55555555u;
+            return v;
+        };
+        const auto x = static_cast<std::uint32_t>((p.x() - lower_.x()) * inverse_size_);
+        const auto y = static_cast<std::uint32_t>((p.y() - lower_.y()) * inverse_size_);
+        return spread(x) | (spread(y) << 1);
+    }
+
+    void emit(int a, int b, int c) {
+        out_.push_back({static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+                        static_cast<std::uint32_t>(c)});
+    }
+
+    void remove(int p) {
+        Node& node = nodes_[p];
+        nodes_[node.next].prev = node.prev;
+        nodes_[node.prev].next = node.next;
+        if (node.prev_z >= 0) nodes_[node.prev_z].next_z = node.next_z;
+        if (node.next_z >= 0) nodes_[node.next_z].prev_z = node.prev_z;
+    }
+
+    /// Whether corner p, a reflex or collinear corner, lies in the closed ear (a, b, c) and is
+    /// not a repetition of a (a keyhole's bridge end).
+    bool blocks(int p, int a, int b, int c) const {
+        if (p == a || p == b || p == c || same_place(p, a)) return false;
+        if (!(cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0))
+            return false;
+        return cross(nodes_[p].prev, p, nodes_[p].next) <= 0.0;
+    }
+
+    bool is_ear(int b) const {
+        const int a = nodes_[b].prev, c = nodes_[b].next;
+        if (!(cross(a, b, c) > 0.0)) return false;  // reflex or collinear: not an ear
+        const Eigen::Vector2d lower = points_[a].cwiseMin(points_[b]).cwiseMin(points_[c]);
+        const Eigen::Vector2d upper = points_[a].cwiseMax(points_[b]).cwiseMax(points_[c]);
+        const std::uint32_t z_min = morton(lower), z_max = morton(upper);
+        auto in_box = [&](int p) {
+            const Eigen::Vector2d& q = points_[p];
+            return q.x() >= lower.x() && q.x() <= upper.x() && q.y() >= lower.y() &&
+                   q.y() <= upper.y();
+        };
+        // Every corner in the box has a Morton code in [z_min, z_max]: walk both ways from
+        // the ear's own code.
+        for (int p = nodes_[b].prev_z; p >= 0 && nodes_[p].z >= z_min; p = nodes_[p].prev_z) {
+            if (in_box(p) && blocks(p, a, b, c)) return false;
+        }
+        for (int p = nodes_[b].next_z; p >= 0 && nodes_[p].z <= z_max; p = nodes_[p].next_z) {
+            if (in_box(p) && blocks(p, a, b, c)) return false;
+        }
+        return true;
+    }
+
+    /// Removes corners that repeat their successor's place or are collinear with their
+    /// neighbours, starting at `start`; returns a corner still in the ring (-1: fewer than 3).
+    int filter(int start) {
+        if (start < 0) return start;
+        int end = start, p = start;
+        bool again;
+        do {
+            again = false;
+            const int next = nodes_[p].next;
+            if (same_place(p, next) || cross(nodes_[p].prev, p, next) == 0.0) {
+                remove(p);
+                p = end = nodes_[p].prev;
+                if (p == nodes_[p].next || nodes_[p].prev == nodes_[p].next) return -1;
+                again = true;
+            } else {
+                p = next;
+            }
+        } while (again || p != end);
+        return end;
+    }
+
+    bool locally_inside(int a, int b) const {
+        const int prev = nodes_[a].prev, next = nodes_[a].next;
+        return cross(prev, a, next) > 0.0 ? cross(a, b, next) <= 0.0 && cross(a, prev, b) <= 0.0
+                                          : cross(a, b, prev) > 0.0 || cross(a, next, b) > 0.0;
+    }
+
+    bool segments_cross(int p1, int q1, int p2, int q2) const {
+        auto sign = [](double v) { return (v > 0.0) - (v < 0.0); };
+        auto on_segment = [&](int p, int q, int r) {
+            const Eigen::Vector2d &a = points_[p], &b = points_[q], &c = points_[r];
+            return b.x() <= std::max(a.x(), c.x()) && b.x() >= std::min(a.x(), c.x()) &&
+                   b.y() <= std::max(a.y(), c.y()) && b.y() >= std::min(a.y(), c.y());
+        };
+        const int o1 = sign(cross(p1, q1, p2)), o2 = sign(cross(p1, q1, q2));
+        const int o3 = sign(cross(p2, q2, p1)), o4 = sign(cross(p2, q2, q1));
+        if (o1 != o2 && o3 != o4) return true;
+        return (o1 == 0 && on_segment(p1, p2, q1)) || (o2 == 0 && on_segment(p1, q2, q1)) ||
+               (o3 == 0 && on_segment(p2, p1, q2)) || (o4 == 0 && on_segment(p2, q1, q2));
+    }
+
+    /// Where the ring crosses itself over one corner (a, p, p.next, b with ap crossing
+    /// p.next b), cuts off the triangle (a, p, b).
+    int cure_local_intersections(int start) {
+        if (start < 0) return start;
+        int p = start;
+        do {
+            const int a = nodes_[p].prev, b = nodes_[nodes_[p].next].next;
+            if (!same_place(a, b) && segments_cross(a, p, nodes_[p].next, b) &&
+                locally_inside(a, b) && locally_inside(b, a)) {
+                emit(a, p, b);
+                cut_crossings_ = true;
+                remove(nodes_[p].next);
+                remove(p);
+                p = start = b;
+            }
+            p = nodes_[p].next;
+        } while (p != start && nodes_[p].prev != nodes_[p].next);
+        return p;
+    }
+
+public:
+    /// Whether a self-crossing of the ring was cut off (the polygon was not simple).
+    bool cut_crossings() const { return cut_crossings_; }
+
+private:
+    const std::vector<Eigen::Vector2d>& points_;
+    std::vector<std::array<std::uint32_t, 3>>& out_;
+    bool cut_crossings_ = false;
+    std::vector<Node> nodes_;
+    Eigen::Vector2d lower_;
+    double inverse_size_ = 0.0;
+};
+
+/// Splits a polygon into triangles in the plane of its Newell normal, keeping its winding:
+/// EarClipper's ear clipping, which keeps repeated corners, so a face written as a keyhole
+/// (a hole joined to the outer loop by a bridge) keeps its hole. Returns false when the
+/// polygon was not simple: its edges cross (a crossing was cut off) or it collapses, or
+/// corners were left that no ear could take and were fanned. Its triangles' area may then
+/// differ from the polygon's; the fan's degenerate triangles are dropped by validation.
+bool triangulate(std::span<const std::uint32_t> polygon,
                  const std::vector<Eigen::Vector3d>& vertices, std::vector<Triangle>& triangles) {
     const std::size_t n = polygon.size();
     if (n == 3) {
         triangles.push_back({polygon[0], polygon[1], polygon[2]});
-        return;
+        return true;
     }
     auto fan = [&](std::span<const std::uint32_t> corners) {
         for (std::size_t k = 1; k + 1 < corners.size(); ++k) {
@@ -1051,7 +1286,7 @@ void triangulate(std::span<const std::uint32_t> polygon,
     }
     if (!(normal.squaredNorm() > 0.0)) {
         fan(polygon);
-        return;
+        return false;
     }
     // Project along the dominant normal axis; (x, y, axis) is a cyclic order, so the projected
     // polygon is counter-clockwise exactly when normal[axis] > 0. Mirror it otherwise.
@@ -1064,42 +1299,17 @@ void triangulate(std::span<const std::uint32_t> polygon,
         const Eigen::Vector3d& p = vertices[polygon[i]];
         points[i] = Eigen::Vector2d(p[x], mirror * p[y]);
     }
-    auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
-        return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-    };
-    std::vector<std::uint32_t> remaining(n);
-    for (std::size_t i = 0; i < n; ++i) remaining[i] = static_cast<std::uint32_t>(i);
-    while (remaining.size() > 3) {
-        const std::size_t m = remaining.size();
-        bool clipped = false;
-        for (std::size_t k = 0; k < m && !clipped; ++k) {
-            const std::uint32_t i0 = remaining[(k + m - 1) % m], i1 = remaining[k],
-                                i2 = remaining[(k + 1) % m];
-            const Eigen::Vector2d &a = points[i0], &b = points[i1], &c = points[i2];
-            if (!(cross(a, b, c) > 0.0)) continue;  // reflex or collinear corner: not an ear
-            // An ear contains no other remaining corner (closed test, so touching ones block it).
-            bool empty = true;
-            for (std::uint32_t j : remaining) {
-                if (j == i0 || j == i1 || j == i2) continue;
-                const Eigen::Vector2d& p = points[j];
-                if (cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0) {
-                    empty = false;
-                    break;
-                }
-            }
-            if (!empty) continue;
-            triangles.push_back({polygon[i0], polygon[i1], polygon[i2]});
-            remaining.erase(remaining.begin() + static_cast<std::ptrdiff_t>(k));
-            clipped = true;
-        }
-        if (!clipped) {
-            std::vector<std::uint32_t> rest;
-            for (std::uint32_t i : remaining) rest.push_back(polygon[i]);
-            fan(rest);
-            return;
-        }
-    }
-    triangles.push_back({polygon[remaining[0]], polygon[remaining[1]], polygon[remaining[2]]});
+    std::vector<std::array<std::uint32_t, 3>> corners;
+    corners.reserve(n - 2);
+    EarClipper clipper(points, corners);
+    const std::vector<std::uint32_t> left = clipper.run();
+    for (const auto& t : corners)
+        triangles.push_back({polygon[t[0]], polygon[t[1]], polygon[t[2]]});
+    if (left.size() < 3) return !clipper.cut_crossings();
+    std::vector<std::uint32_t> rest;
+    for (std::uint32_t i : left) rest.push_back(polygon[i]);
+    fan(rest);
+    return false;
 }
 
 // Validation
@@ -1159,65 +1369,56 @@ MeshReport validate_mesh(TriangleMeshData& mesh) {
     const std::size_t triangle_count = triangles.size();
     auto repeated = [&](const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; };
 
-    // Triangles incident to each vertex (compressed rows), for edge adjacency. Triangles with
-    // repeated corners have no proper edges and take no part in the topology; zero-area
-    // triangles with three distinct corners do (they may close a T-junction).
-    std::vector<std::uint32_t> first_incident(vertex_count + 1, 0);
-    for (const Triangle& t : triangles) {
-        if (repeated(t)) continue;
-        for (std::uint32_t index : t) ++first_incident[index + 1];
-    }
-    for (std::size_t v = 0; v < vertex_count; ++v) first_incident[v + 1] += first_incident[v];
-    std::vector<std::uint32_t> incident(first_incident[vertex_count]);
-    {
-        std::vector<std::uint32_t> cursor(first_incident.begin(), first_incident.end() - 1);
-        for (std::size_t f = 0; f < triangle_count; ++f) {
-            if (repeated(triangles[f])) continue;
-            for (std::uint32_t index : triangles[f])
-                incident[cursor[index]++] = static_cast<std::uint32_t>(f);
-        }
-    }
-    auto edge_position = [&](const Triangle& t, std::uint32_t a, std::uint32_t b) {
-        for (int k = 0; k < 3; ++k) {
-            if ((t[k] == a && t[(k + 1) % 3] == b) || (t[k] == b && t[(k + 1) % 3] == a)) return k;
-        }
-        return -1;
+    // Each undirected edge once: every triangle side with three distinct corners, sorted by
+    // its end points, so the sides of one edge are adjacent (a sort, not a scan of the
+    // triangles around a vertex per side, which is quadratic at the hub of a fan such as a
+    // long polygon's triangulation). Repeated-corner triangles have no proper edges and take
+    // no part in the topology; zero-area ones with distinct corners do (they may close a
+    // T-junction). Manifold edges link their two triangles; the link says whether both
+    // traverse the edge in the same direction (inconsistent winding).
+    struct Side {
+        std::uint32_t low, high, face;
+        int k;
     };
-
-    // Each undirected edge is examined once, from the lowest-numbered triangle that has it.
-    // Manifold edges link their two triangles; the link says whether both traverse the edge in
-    // the same direction (inconsistent winding).
-    std::vector<std::uint32_t> neighbour(3 * triangle_count, kNone);
+    std::vector<Side> sides;
+    sides.reserve(3 * triangle_count);
     for (std::size_t f = 0; f < triangle_count; ++f) {
         const Triangle& t = triangles[f];
         if (repeated(t)) continue;
         for (int k = 0; k < 3; ++k) {
             const std::uint32_t a = t[k], b = t[(k + 1) % 3];
-            const std::uint32_t low = std::min(a, b);
-            std::size_t sharing = 0;
-            std::uint32_t lowest = static_cast<std::uint32_t>(f), other = kNone;
-            for (std::uint32_t i = first_incident[low]; i < first_incident[low + 1]; ++i) {
-                const std::uint32_t g = incident[i];
-                if (edge_position(triangles[g], a, b) < 0) continue;
-                ++sharing;
-                lowest = std::min(lowest, g);
-                if (g != f && other == kNone) other = g;
-            }
-            if (lowest != f) continue;
-            ++report.edges;
-            if (sharing == 1) {
-                ++report.boundary_edges;
-            } else if (sharing > 2) {
-                ++report.non_manifold_edges;
-            } else {
-                const int k2 = edge_position(triangles[other], a, b);
-                const bool same = triangles[other][k2] == a;
-                report.inconsistent_edges += same ? 1 : 0;
-                const std::uint32_t flag = same ? kSameDirection : 0;
-                neighbour[3 * f + k] = other | flag;
-                neighbour[3 * other + k2] = static_cast<std::uint32_t>(f) | flag;
-            }
+            sides.push_back({std::min(a, b), std::max(a, b), static_cast<std::uint32_t>(f), k});
         }
+    }
+    std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) {
+        if (x.low != y.low) return x.low < y.low;
+        if (x.high != y.high) return x.high < y.high;
+        return x.face < y.face;
+    });
+    std::vector<std::uint32_t> neighbour(3 * triangle_count, kNone);
+    for (std::size_t begin = 0; begin < sides.size();) {
+        std::size_t end = begin + 1;
+        while (end < sides.size() && sides[end].low == sides[begin].low &&
+               sides[end].high == sides[begin].high) {
+            ++end;
+        }
+        const std::size_t sharing = end - begin;
+        ++report.edges;
+        if (sharing == 1) {
+            ++report.boundary_edges;
+        } else if (sharing > 2) {
+            ++report.non_manifold_edges;
+        } else {
+            const Side& first = sides[begin];
+            const Side& second = sides[begin + 1];
+            // Both sides start at the same corner: they run the same way.
+            const bool same = triangles[first.face][first.k] == triangles[second.face][second.k];
+            report.inconsistent_edges += same ? 1 : 0;
+            const std::uint32_t flag = same ? kSameDirection : 0;
+            neighbour[3 * first.face + first.k] = second.face | flag;
+            neighbour[3 * second.face + second.k] = first.face | flag;
+        }
+        begin = end;
     }
 
     // Orientation: propagate a winding through each component and flip the side with fewer
@@ -1474,6 +1675,35 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
     }
     mesh.triangles.reserve(face_count + face_count / 2);
     std::vector<std::uint32_t> polygon;
+    // OBJ: the next face as the file wrote it. OpenMesh dropped those with fewer than three
+    // distinct corners; the others must be OpenMesh's faces with their repeats put back.
+    std::size_t written = 0;
+    std::unordered_set<long long> seen;
+    auto as_written = [&](std::size_t f) {
+        for (; written < expect.written_starts.size(); ++written) {
+            const std::size_t begin = expect.written_starts[written];
+            const std::size_t end = written + 1 < expect.written_starts.size()
+                                        ? expect.written_starts[written + 1]
+                                        : expect.written_corners.size();
+            seen.clear();
+            std::size_t k = 0;
+            bool agrees = true;
+            for (std::size_t c = begin; c < end; ++c) {
+                const long long index = expect.written_corners[c];
+                if (!seen.insert(index).second) continue;
+                agrees = agrees && k < polygon.size() && polygon[k] == index;
+                ++k;
+            }
+            if (k < 3) continue;
+            if (!agrees || k != polygon.size())
+                fail("OpenMesh's " + face_name(f) + " disagrees with the file's");
+            polygon.assign(expect.written_corners.begin() + static_cast<std::ptrdiff_t>(begin),
+                           expect.written_corners.begin() + static_cast<std::ptrdiff_t>(end));
+            ++written;
+            return;
+        }
+        fail("OpenMesh read more faces than the file has");
+    };
     for (std::size_t f = 0; f < face_count; ++f) {
         const std::span<const int> face = importer.face(f);
         if (face.size() < 3)
@@ -1486,8 +1716,9 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
             }
             polygon.push_back(static_cast<std::uint32_t>(index));
         }
-        report.triangulated_faces += face.size() > 3 ? 1 : 0;
-        triangulate(polygon, mesh.vertices, mesh.triangles);
+        if (!expect.written_starts.empty()) as_written(f);
+        report.triangulated_faces += polygon.size() > 3 ? 1 : 0;
+        if (!triangulate(polygon, mesh.vertices, mesh.triangles)) ++report.non_simple_faces;
     }
     importer = RecordingImporter();
     const std::size_t triangle_count = mesh.triangles.size();
@@ -1502,6 +1733,7 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
         validation.faces = report.faces;
         validation.dropped_faces = report.dropped_faces;
         validation.triangulated_faces = report.triangulated_faces;
+        validation.non_simple_faces = report.non_simple_faces;
         report = std::move(validation);
     } catch (const InvalidParameter&) {
         // Vertices and indices were checked above; what validation can still reject is a mesh
@@ -1554,6 +1786,11 @@ std::string describe(const MeshReport& report) {
     if (report.faces != 0) out << " from " << report.faces << " faces";
     if (report.triangulated_faces)
         out << " (" << report.triangulated_faces << " polygons triangulated)";
+    if (report.welded_vertices) out << ", " << report.welded_vertices << " vertices welded";
+    if (report.non_simple_faces) {
+        out << ", " << report.non_simple_faces
+            << " polygons not simple (edges cross or collapse: cut at the crossings or fanned)";
+    }
     if (report.dropped_faces) out << ", " << report.dropped_faces << " faces dropped by the reader";
     if (report.degenerate_triangles)
         out << ", " << report.degenerate_triangles << " degenerate triangles dropped";

@@ -14,9 +14,12 @@
 #include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
 #pragma GCC diagnostic pop
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "csgrt/core/error.h"
 #include "openmesh_session.h"
@@ -138,6 +141,42 @@ TriangleMeshData decimate(const TriangleMeshData& mesh, std::size_t target_trian
         decimater.decimate_to_faces(0, target_triangles);
     }
     return from_half_edges(half_edges, report);
+}
+
+std::size_t weld_vertices(TriangleMeshData& mesh) {
+    const std::size_t count = mesh.vertices.size();
+    std::vector<std::uint32_t> order(count);
+    for (std::size_t i = 0; i < count; ++i) order[i] = static_cast<std::uint32_t>(i);
+    // Lexicographic order of the positions, ties by index, so each group of equal positions
+    // is contiguous and keeps its first vertex.
+    auto less = [&](std::uint32_t a, std::uint32_t b) {
+        const Eigen::Vector3d &p = mesh.vertices[a], &q = mesh.vertices[b];
+        if (p.x() != q.x()) return p.x() < q.x();
+        if (p.y() != q.y()) return p.y() < q.y();
+        if (p.z() != q.z()) return p.z() < q.z();
+        return a < b;
+    };
+    std::sort(order.begin(), order.end(), less);
+    std::vector<std::uint32_t> representative(count);
+    for (std::size_t k = 0; k < count; ++k) {
+        const bool same = k > 0 && mesh.vertices[order[k]] == mesh.vertices[order[k - 1]];
+        representative[order[k]] = same ? representative[order[k - 1]] : order[k];
+    }
+    // Renumber the kept vertices in their original order.
+    std::vector<std::uint32_t> new_index(count, std::numeric_limits<std::uint32_t>::max());
+    std::vector<Eigen::Vector3d> kept;
+    for (std::size_t i = 0; i < count; ++i) {
+        if (representative[i] != i) continue;
+        new_index[i] = static_cast<std::uint32_t>(kept.size());
+        kept.push_back(mesh.vertices[i]);
+    }
+    for (auto& triangle : mesh.triangles) {
+        for (std::uint32_t& corner : triangle) corner = new_index[representative[corner]];
+    }
+    const std::size_t merged = count - kept.size();
+    mesh.vertices = std::move(kept);
+    mesh.normals.clear();
+    return merged;
 }
 
 }  // namespace csgrt

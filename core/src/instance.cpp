@@ -48,6 +48,19 @@ bool Instance::contains(const Point3& p) const {
 Hit Instance::to_world(const Hit& object_hit) const {
     Hit hit = object_hit;
     hit.point = world_from_object_.apply_point(object_hit.point);
+    // The object-space error stretched by the map (the infinity norm of L), plus the rounding
+    // of each way through it, gamma(3) of |L| |p| + |c| per coordinate: the world point's, and
+    // that of a ray leaving it, whose origin is mapped back down (pbrt-v4's transform errors).
+    const Eigen::Matrix3d& linear = world_from_object_.linear();
+    const double stretch = linear.cwiseAbs().rowwise().sum().maxCoeff();
+    const double to_world = (linear.cwiseAbs() * object_hit.point.cwiseAbs() +
+                             world_from_object_.translation().cwiseAbs())
+                                .maxCoeff();
+    const double to_object = (object_from_world_.linear().cwiseAbs() * hit.point.cwiseAbs() +
+                              object_from_world_.translation().cwiseAbs())
+                                 .maxCoeff();
+    hit.point_error =
+        stretch * (object_hit.point_error + gamma(3) * to_object) + gamma(3) * to_world;
     hit.geometric_normal =
         world_from_object_.apply_normal(object_hit.geometric_normal).normalized();
     hit.shading_normal = world_from_object_.apply_normal(object_hit.shading_normal).normalized();

@@ -1,5 +1,7 @@
 #include "csgrt/core/shape.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -53,11 +55,28 @@ SpanList Shape::spans(const Ray& ray) const {
 
 namespace {
 
+// The leaf's hit with at least the double-precision point error (kDoubleHitErrorUlps); a leaf
+// that knows a larger one (a float mesh) has set it already.
+Hit finish_leaf(const Ray& ray, const HitRecord& record) {
+    Hit hit = record.shape->finish(ray, record);
+    double magnitude = std::max(hit.point.cwiseAbs().maxCoeff(), ray.origin.cwiseAbs().maxCoeff());
+    const Aabb bounds = record.shape->bounds();
+    if (!bounds.is_empty() && bounds.is_finite()) {
+        magnitude = std::max(
+            {magnitude, bounds.lower.cwiseAbs().maxCoeff(), bounds.upper.cwiseAbs().maxCoeff()});
+    }
+    if (std::isfinite(magnitude)) {
+        hit.point_error =
+            std::max(hit.point_error, kDoubleHitErrorUlps * kUnitRoundoff * magnitude);
+    }
+    return hit;
+}
+
 // Walks the instance path outermost first: each instance maps the ray into its object space,
 // the leaf finishes there, and each instance maps the hit back on the way out.
 Hit finish_along_path(const Ray& ray, const HitRecord& record, std::uint32_t path,
                       const QueryScratch& scratch) {
-    if (path == kNoIndex) return record.shape->finish(ray, record);
+    if (path == kNoIndex) return finish_leaf(ray, record);
     const QueryScratch::PathNode& node = scratch.path_node(path);
     const Ray object_ray = node.instance->object_from_world().apply(ray);
     return node.instance->to_world(finish_along_path(object_ray, record, node.inner, scratch));

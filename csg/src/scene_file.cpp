@@ -867,10 +867,19 @@ ShapePointer Loader::mesh(Fields& fields) {
     MeshConfig config;
     config.double_precision = fields.boolean("double_precision", false);
     config.accelerator = fields.string("accelerator", config.accelerator);
+    // Shading and welding (docs/scene-format.md): "flat", "crease_degrees" in (0, 180],
+    // "weld" (merge vertices at equal positions: a per-corner soup becomes a solid).
+    config.flat_shading = fields.boolean("flat", false);
+    const double crease_degrees = fields.number("crease_degrees", 180.0);
+    if (!(crease_degrees > 0.0 && crease_degrees <= 180.0))
+        fields.fail("crease_degrees", "expected an angle in (0, 180] degrees");
+    config.crease_angle = crease_degrees * kPi / 180.0;
+    config.weld_vertices = fields.boolean("weld", false);
     const std::filesystem::path file = source_.directory / path;
-    const std::string key = file.lexically_normal().string() + "|" +
-                            (config.double_precision ? "double" : "float") + "|" +
-                            config.accelerator;
+    const std::string key =
+        file.lexically_normal().string() + "|" + (config.double_precision ? "double" : "float") +
+        "|" + config.accelerator + "|" + (config.flat_shading ? "flat" : "smooth") + "|" +
+        std::to_string(crease_degrees) + "|" + (config.weld_vertices ? "weld" : "");
     if (const auto found = meshes_.find(key); found != meshes_.end()) return found->second;
     ShapePointer loaded;
     try {
@@ -1353,6 +1362,7 @@ struct NodeCounts {
     std::map<std::string_view, std::uint64_t> kinds;
     std::uint64_t leaves = 0;
     std::uint64_t triangles = 0;
+    std::uint64_t closed_meshes = 0;
 };
 
 void add_counts(NodeCounts& into, const NodeCounts& from) {
@@ -1361,6 +1371,7 @@ void add_counts(NodeCounts& into, const NodeCounts& from) {
     }
     into.leaves = saturating_add(into.leaves, from.leaves);
     into.triangles = saturating_add(into.triangles, from.triangles);
+    into.closed_meshes = saturating_add(into.closed_meshes, from.closed_meshes);
 }
 
 /// Memoised for every composite but instances (which the loader folds into one per use, so
@@ -1375,6 +1386,7 @@ NodeCounts count_node(const Shape& shape, std::unordered_map<const Shape*, NodeC
         // The one leaf kind with parts of its own.
         if (const auto* mesh = dynamic_cast<const Mesh*>(&shape)) {
             counts.triangles = mesh->triangle_count();
+            counts.closed_meshes = mesh->report().is_closed ? 1 : 0;
         }
         return counts;
     }
@@ -1398,6 +1410,7 @@ SceneShapeCounts count_scene_shapes(const Scene& scene) {
     }
     counts.leaves = total.leaves;
     counts.triangles = total.triangles;
+    counts.closed_meshes = total.closed_meshes;
     return counts;
 }
 

@@ -3,7 +3,9 @@
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/intersections.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -20,6 +22,14 @@ using Traits = CGAL::AABB_traits<Kernel, Primitive>;
 using Tree = CGAL::AABB_tree<Traits>;
 
 Kernel::Point_3 to_cgal(const Eigen::Vector3d& p) {
+    return {p.x(), p.y(), p.z()};
+}
+
+/// Exact constructions, for the rays that lie in a triangle's plane: there the hit is a
+/// segment, and its near end is a constructed point.
+using ExactKernel = CGAL::Exact_predicates_exact_constructions_kernel;
+
+ExactKernel::Point_3 to_exact(const Eigen::Vector3d& p) {
     return {p.x(), p.y(), p.z()};
 }
 }  // namespace
@@ -96,12 +106,55 @@ long double CgalReference::plane_t(const Ray& ray, std::uint32_t primitive) cons
            normal.dot(ray.direction.cast<long double>());
 }
 
+std::optional<double> CgalReference::in_plane_t(const Ray& ray, std::uint32_t primitive) const {
+    using Exact = ExactKernel;
+    const auto& c = corners_[primitive];
+    const Exact::Triangle_3 triangle(to_exact(c[0]), to_exact(c[1]), to_exact(c[2]));
+    const Exact::Point_3 origin = to_exact(ray.origin);
+    const Exact::Vector_3 direction(ray.direction.x(), ray.direction.y(), ray.direction.z());
+    // The same query as with_cgal_query, built exactly from the same doubles.
+    const Point3 start_point = ray.t_min == 0.0 ? ray.origin : ray.at(ray.t_min);
+    const Exact::Point_3 start = to_exact(start_point);
+    const bool unbounded = ray.t_max == std::numeric_limits<double>::infinity();
+    const Exact::Point_3 second = unbounded ? start + direction : to_exact(ray.at(ray.t_max));
+    if (triangle.is_degenerate() || !CGAL::coplanar(triangle[0], triangle[1], triangle[2], start) ||
+        !CGAL::coplanar(triangle[0], triangle[1], triangle[2], second)) {
+        return std::nullopt;
+    }
+    // t of a point of the overlap: (p - o) . d / (d . d), exactly, rounded once.
+    auto t_of = [&](const Exact::Point_3& p) {
+        return ((p - origin) * direction) / direction.squared_length();
+    };
+    std::optional<Exact::FT> nearest;
+    auto consider = [&](const Exact::Point_3& p) {
+        const Exact::FT t = t_of(p);
+        if (!nearest || t < *nearest) nearest = t;
+    };
+    auto take = [&](const auto& overlap) {
+        if (!overlap) return;
+        if (const auto* point = boost::get<Exact::Point_3>(&*overlap)) {
+            consider(*point);
+        } else if (const auto* segment = boost::get<Exact::Segment_3>(&*overlap)) {
+            consider(segment->source());
+            consider(segment->target());
+        }
+    };
+    if (unbounded) {
+        take(CGAL::intersection(Exact::Ray_3(start, direction), triangle));
+    } else {
+        take(CGAL::intersection(Exact::Segment_3(start, second), triangle));
+    }
+    if (!nearest) return std::nullopt;
+    return std::clamp(CGAL::to_double(*nearest), ray.t_min, ray.t_max);
+}
+
 std::optional<CgalReference::Answer> CgalReference::nearest(const Ray& ray) const {
     std::optional<Answer> best;
     for (std::uint32_t primitive : intersected_primitives(ray)) {
-        long double t = plane_t(ray, primitive);
-        if (!std::isfinite(static_cast<double>(t))) t = ray.t_min;  // the ray lies in the plane
-        const double rounded = static_cast<double>(t);
+        // A ray in the triangle's plane meets it in a segment: the near end, constructed
+        // exactly. Otherwise the plane's t in long double.
+        const std::optional<double> in_plane = in_plane_t(ray, primitive);
+        const double rounded = in_plane ? *in_plane : static_cast<double>(plane_t(ray, primitive));
         if (!best || rounded < best->t) best = Answer{rounded, primitive};
     }
     return best;

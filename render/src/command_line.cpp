@@ -419,6 +419,11 @@ void info_command(const std::string& scene_path, bool json, CommandLineStreams s
         if (kind == "mesh") out << " (" << counts.triangles << " triangles in all)";
         out << '\n';
     }
+    if (const auto meshes = counts.by_kind.find("mesh"); meshes != counts.by_kind.end()) {
+        out << "meshes:     " << counts.closed_meshes
+            << " closed (solids: CSG operands, inside/outside), "
+            << meshes->second - counts.closed_meshes << " open\n";
+    }
     std::size_t point_lights = 0;
     for (const Light& light : scene.lights())
         point_lights += std::holds_alternative<PointLight>(light);

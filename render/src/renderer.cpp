@@ -28,21 +28,8 @@ struct Frame {
     const Scene& scene;
     const RenderSettings& settings;
     CameraFilm film;
-    double scene_magnitude;
     StrataGrid strata;
 };
-
-/// The largest coordinate magnitude of the scene's bounds and camera: the scale the shadow
-/// offset falls back to near the origin.
-double scene_magnitude(const Scene& scene) {
-    double magnitude = scene.camera().position.cwiseAbs().maxCoeff();
-    const Aabb& bounds = scene.bounds();
-    if (!bounds.is_empty() && bounds.is_finite()) {
-        magnitude = std::max(
-            {magnitude, bounds.lower.cwiseAbs().maxCoeff(), bounds.upper.cwiseAbs().maxCoeff()});
-    }
-    return magnitude;
-}
 
 /// What one worker counts for the statistics (RenderStats), summed when the render ends.
 struct RayTally {
@@ -85,7 +72,8 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
         return albedo * std::abs(shading.dot(view)) + albedo.cwiseProduct(frame.settings.ambient);
     }
 
-    const Point3 origin = offset_ray_origin(hit.point, geometric, frame.scene_magnitude);
+    // Sized by the precision of the surface hit, not by the scene's distance from the origin.
+    const Point3 origin = spawn_ray_origin(hit, geometric);
     Vector3 radiance = albedo.cwiseProduct(frame.settings.ambient);
     for (const Light& light : frame.scene.lights()) {
         Vector3 to_light;
@@ -143,10 +131,11 @@ Vector3 trace(const Frame& frame, const Ray& ray, QueryScratch& scratch, RayTall
 }
 
 /// A ray leaving hit.point along `direction`, on the side of `side` (the geometric normal
-/// turned to that side), from the offset origin shadow rays use.
-Ray spawned_ray(const Frame& frame, const Hit& hit, const Normal3& side, const Vector3& direction) {
+/// turned to that side), from the origin shadow rays use (spawn_ray_origin: sized by the
+/// precision of the surface hit).
+Ray spawned_ray(const Hit& hit, const Normal3& side, const Vector3& direction) {
     Ray ray;
-    ray.origin = offset_ray_origin(hit.point, side, frame.scene_magnitude);
+    ray.origin = spawn_ray_origin(hit, side);
     ray.direction = direction;
     ray.t_max = kInfinity;
     return ray;
@@ -171,12 +160,12 @@ Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryS
             fresnel_dielectric(-direction.dot(normal), eta_incident, eta_transmitted);
         Vector3 radiance =
             reflectance * trace(frame,
-                                spawned_ray(frame, hit, geometric, reflect(direction, normal)),
+                                spawned_ray(hit, geometric, reflect(direction, normal)),
                                 scratch, tally, depth + 1);
         if (reflectance < 1.0) {
             if (const auto refracted = refract(direction, normal, eta_incident / eta_transmitted)) {
                 radiance += (1.0 - reflectance) *
-                            trace(frame, spawned_ray(frame, hit, -geometric, *refracted), scratch,
+                            trace(frame, spawned_ray(hit, -geometric, *refracted), scratch,
                                   tally, depth + 1);
             }
         }
@@ -189,7 +178,7 @@ Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryS
         Normal3 normal = hit.shading_normal;
         if (normal.dot(geometric) < 0.0) normal = -normal;
         radiance += material.mirror.cwiseProduct(
-            trace(frame, spawned_ray(frame, hit, geometric, reflect(direction, normal)), scratch,
+            trace(frame, spawned_ray(hit, geometric, reflect(direction, normal)), scratch,
                   tally, depth + 1));
     }
     return radiance;
@@ -279,7 +268,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
     RenderResult result{Image(settings.width, settings.height), {}};
     const Frame frame{scene, settings,
                       CameraFilm(scene.camera(), double(settings.width) / settings.height),
-                      scene_magnitude(scene), strata_for(settings.samples_per_pixel)};
+                      strata_for(settings.samples_per_pixel)};
 
     const int tiles_x = (settings.width + settings.tile_size - 1) / settings.tile_size;
     const int tiles_y = (settings.height + settings.tile_size - 1) / settings.tile_size;

@@ -17,4 +17,22 @@ Point3 offset_ray_origin(const Point3& p, const Normal3& normal, double scene_ma
     return p + ray_offset_distance(p, scene_magnitude) * normal;
 }
 
+double spawn_offset_distance(const Hit& hit, const Normal3& side) {
+    // The point error bounds each coordinate; |n|_1 e is how far the error box reaches along n.
+    return side.cwiseAbs().sum() * hit.point_error;
+}
+
+Point3 spawn_ray_origin(const Hit& hit, const Normal3& side) {
+    const double distance = spawn_offset_distance(hit, side);
+    Point3 origin = hit.point + distance * side;
+    for (int axis = 0; axis < 3; ++axis) {
+        if (side[axis] > 0.0) {
+            origin[axis] = std::nextafter(origin[axis], kInfinity);
+        } else if (side[axis] < 0.0) {
+            origin[axis] = std::nextafter(origin[axis], -kInfinity);
+        }
+    }
+    return origin;
+}
+
 }  // namespace csgrt

@@ -29,6 +29,16 @@ struct MeshConfig {
     /// The factory name of the structure over the triangles (accel/factory.h).
     std::string accelerator = default_mesh_accelerator();
     AcceleratorConfig accelerator_config;
+    /// Merge vertices at equal positions before validation (weld_vertices, mesh_tools.h), so
+    /// that a soup written one vertex per corner is recognised as the closed solid it is.
+    bool weld_vertices = false;
+    /// Shade with each triangle's own normal instead of interpolated vertex normals.
+    bool flat_shading = false;
+    /// Smooth shading joins faces meeting at a vertex only when their normals differ by at most
+    /// this angle (radians): a corner's normal is the angle-weighted sum of the normals of the
+    /// faces at its vertex within the angle of its own face, so edges sharper than the angle
+    /// stay sharp. Pi (the default) joins every face (plain vertex normals).
+    double crease_angle = kPi;
 };
 
 /// A triangle mesh as one shape: its triangles in a TriangleSet (float by default, double on
@@ -96,6 +106,9 @@ private:
     bool double_precision_ = false;
     std::vector<std::array<std::uint32_t, 3>> triangles_;
     std::vector<Eigen::Vector3f> normals_;
+    /// Per-corner normals when a crease angle splits vertex normals (else empty).
+    std::vector<std::array<Eigen::Vector3f, 3>> corner_normals_;
+    bool flat_shading_ = false;
     MeshReport report_;
     Aabb bounds_;
     TriangleSet<float> float_set_;

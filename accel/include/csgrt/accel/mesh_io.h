@@ -46,6 +46,13 @@ struct MeshReport {
     std::size_t dropped_faces = 0;
     /// Faces with more than 3 corners, split into triangles by ear clipping.
     std::size_t triangulated_faces = 0;
+    /// Of those, faces that are not simple polygons (their edges cross, or they collapse onto
+    /// a line): ear clipping cut them at the crossings or split what it could not clip as a fan
+    /// from one corner, so their triangles' area may differ from the polygon's. A keyhole (a
+    /// hole joined by a bridge whose corners repeat) is simple enough and is not counted.
+    std::size_t non_simple_faces = 0;
+    /// Vertices merged into another at the same position (MeshConfig::weld_vertices).
+    std::size_t welded_vertices = 0;
     std::size_t vertices = 0;
     /// Triangles kept, after degenerate ones were dropped.
     std::size_t triangles = 0;

@@ -24,4 +24,13 @@ TriangleMeshData loop_subdivide(const TriangleMeshData& mesh, int levels,
 TriangleMeshData decimate(const TriangleMeshData& mesh, std::size_t target_triangles,
                           MeshReport* report = nullptr);
 
+/// Merges vertices at the same position (every coordinate equal: a soup written one vertex
+/// per corner, as exporters do for per-corner normals or colours) into one, so that triangles
+/// that meet share their edges and a closed surface is recognised as a solid. Returns how many
+/// vertices were merged away; the triangles are renumbered, unreferenced copies removed, and
+/// the normals cleared (run validate_mesh afterwards, which recomputes them and the topology).
+/// Linear in the vertices after a sort. Positions equal only to within a rounding are not
+/// merged: a tolerance would join vertices a model means to keep apart.
+std::size_t weld_vertices(TriangleMeshData& mesh);
+
 }  // namespace csgrt

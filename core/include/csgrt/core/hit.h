@@ -33,10 +33,33 @@ struct HitRecord {
     bool flip_normal = false;
 };
 
+/// The point error `finish_hit` gives a hit on a double-precision leaf, in units of the unit
+/// roundoff times the largest coordinate magnitude the leaf's computation saw (the point, the
+/// ray's origin and the leaf's bounds). A hit point reprojected onto the surface is good to a
+/// few ulps; the rest covers the leaf's own test on a ray starting next to the surface, whose
+/// near root is off by a few ulps of the same magnitudes divided by the ray's cosine with the
+/// surface (tests/render/secondary_ray_test.cpp, on every kind of shape at distances up to
+/// 10^6 from the origin and cosines down to 0.02, finds the first self hits at 2^5 and none at
+/// 2^6: 2^9 keeps a factor 8 in hand).
+inline constexpr double kDoubleHitErrorUlps = 0x1.0p9;
+
+/// The point error of a hit on a float triangle, relative to the largest corner coordinate:
+/// the triangle test rounds the ray's origin to float (half a float ulp per coordinate) and
+/// works in float from there. 2^-19, 16 float ulps, is 8 times the 2^-22 that
+/// tests/render/shadow_offset_test.cpp measures as enough and 1/8 of Waechter and Binder's
+/// 2^-16 (their int_scale of 256 ulps).
+inline constexpr double kFloatHitErrorRelative = 0x1.0p-19;
+
 /// A finished hit, in the space of the ray that was queried.
 struct Hit {
     double t = kInfinity;
     Point3 point{0.0, 0.0, 0.0};
+    /// A bound on how far `point` may lie from the surface as the shape's own queries see it,
+    /// in this hit's space: the distance a ray leaving the point must clear not to meet that
+    /// surface again (pbrt-v4's pError box, kept as one length; render/shadow_offset.h). Leaves
+    /// of double shapes get a few ulps of their coordinates, float triangles the float margin
+    /// of Waechter and Binder (2019); instances carry it through their transform.
+    double point_error = 0.0;
     /// Unit normal of the surface as defined (outward for solids), not turned toward the ray.
     Normal3 geometric_normal{0.0, 0.0, 1.0};
     /// Unit normal for shading (interpolated on smooth meshes; else the geometric normal).

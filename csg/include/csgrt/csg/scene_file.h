@@ -47,6 +47,8 @@ struct SceneShapeCounts {
     std::uint64_t leaves = 0;
     /// Triangles of the meshes, each mesh once per use.
     std::uint64_t triangles = 0;
+    /// Meshes (counted as in by_kind) that are closed: solids, usable as CSG operands.
+    std::uint64_t closed_meshes = 0;
 };
 
 /// Counts `scene`'s shapes (`csgrt info`).

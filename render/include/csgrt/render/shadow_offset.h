@@ -1,5 +1,6 @@
 #pragma once
 
+#include "csgrt/core/hit.h"
 #include "csgrt/core/math.h"
 
 namespace csgrt {
@@ -31,5 +32,17 @@ Point3 offset_ray_origin(const Point3& p, const Normal3& normal, double scene_ma
 
 /// The distance `offset_ray_origin` moves `p`.
 double ray_offset_distance(const Point3& p, double scene_magnitude);
+
+/// The origin for a secondary ray leaving `hit` on the side `side` points to (unit length, the
+/// geometric normal turned to that side), sized by the precision of the shape that was hit
+/// rather than by where the scene is: `p + (|n|_1 e) n` for the hit's point error `e`, each
+/// coordinate then stepped one ulp further from the surface so that the sum's own rounding
+/// cannot take it back (pbrt-v4's OffsetRayOrigin). A few double ulps of the coordinates for
+/// analytic shapes and CSG, the float margin for float triangles, carried through instances
+/// (Hit::point_error); the renderer uses this, so a scene moved by 10^6 shadows as at the origin.
+Point3 spawn_ray_origin(const Hit& hit, const Normal3& side);
+
+/// The distance `spawn_ray_origin` moves the hit point along `side` (before the ulp steps).
+double spawn_offset_distance(const Hit& hit, const Normal3& side);
 
 }  // namespace csgrt

@@ -1,0 +1,449 @@
+// Secondary rays spawned by the renderer's rule (spawn_ray_origin: the hit's own point error,
+// render/shadow_offset.h) against three independent answers: "a ray leaving a surface never
+// meets it again" on every kind of shape at every distance from the origin; the same lit and
+// shadowed pixels wherever the scene is placed; and a long-double reference for grazing light
+// in a concave CSG cavity.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "csgrt/accel/mesh.h"
+#include "csgrt/core/shapes.h"
+#include "csgrt/csg/boolean.h"
+#include "csgrt/csg/camera.h"
+#include "csgrt/csg/scene.h"
+#include "csgrt/render/renderer.h"
+#include "csgrt/render/shadow_offset.h"
+#include "support/meshes.h"
+#include "support/random.h"
+
+namespace csgrt {
+namespace {
+
+constexpr std::array<double, 4> kTranslations = {0.0, 1e2, 1e4, 1e6};
+
+/// The direction in which every test scene is moved away from the origin (not along an axis,
+/// so every coordinate grows).
+const Vector3 kShiftDirection = Vector3(0.6, -0.48, 0.64);
+
+struct Subject {
+    std::string name;
+    std::shared_ptr<const Shape> shape;
+    /// Convex solid or flat surface: a ray leaving on the side it arrived from never meets it
+    /// again. Otherwise only a re-hit of the same primitive next to the start is forbidden.
+    bool convex = false;
+};
+
+std::shared_ptr<const Shape> mesh_at(const test::TestMesh& mesh, const Transform& placement,
+                                     bool double_precision) {
+    TriangleMeshData data{mesh.vertices, mesh.triangles, {}};
+    for (Eigen::Vector3d& v : data.vertices) v = placement.apply_point(v);
+    MeshConfig config;
+    config.double_precision = double_precision;
+    return std::make_shared<Mesh>(std::move(data), config);
+}
+
+/// Every kind of leaf, instances with rotation, non-uniform scale and shear, CSG, and meshes
+/// (float and double, placed in world space and under an instance), around `place` with size
+/// `size`.
+std::vector<Subject> subjects(const Point3& place, double size) {
+    const Transform placement = Transform::translate(place) *
+                                Transform::rotate(Vector3(1, 2, 3), 0.7) * Transform::scale(size);
+    Eigen::Matrix3d shear = Eigen::Matrix3d::Identity();
+    shear(0, 1) = 0.6;
+    shear(2, 0) = -0.3;
+    const Transform sheared =
+        placement * Transform(shear, Vector3::Zero()) * Transform::scale(Vector3(2.0, 1.0, 0.5));
+    auto unit_sphere = std::make_shared<Sphere>(Point3(0, 0, 0), 1.0);
+    auto instance = [](std::shared_ptr<const Shape> shape, const Transform& transform) {
+        return std::make_shared<Instance>(std::move(shape), transform);
+    };
+    std::vector<Subject> list;
+    list.push_back({"sphere", std::make_shared<Sphere>(place, size), true});
+    list.push_back({"sheared ellipsoid (instance)", instance(unit_sphere, sheared), true});
+    list.push_back({"box",
+                    std::make_shared<Box>(place - size * Vector3(1, 0.5, 0.75),
+                                          place + size * Vector3(1, 0.5, 0.75)),
+                    true});
+    list.push_back({"cylinder (instance)",
+                    instance(std::make_shared<Cylinder>(1.0, -1.0, 1.0, true), placement), true});
+    list.push_back({"cone (instance)",
+                    instance(std::make_shared<Cone>(1.0, 0.0, 2.0, true), placement), true});
+    list.push_back({"plane", std::make_shared<Plane>(place, Normal3(1, 2, 3).normalized()), true});
+    list.push_back(
+        {"disk", std::make_shared<Disk>(place, Normal3(-1, 2, 0.5).normalized(), size), true});
+    list.push_back({"triangle",
+                    std::make_shared<Triangle>(place + size * Vector3(-1, -0.5, 0.2),
+                                               place + size * Vector3(1, -0.3, -0.1),
+                                               place + size * Vector3(0.1, 1, 0.3)),
+                    true});
+    list.push_back(
+        {"torus (instance)", instance(std::make_shared<Torus>(1.0, 0.25), placement), false});
+    list.push_back(
+        {"part_sphere", std::make_shared<PartSphere>(place, size, 1.0, 5.0, 0.5, 2.5), false});
+    list.push_back({"part_cylinder (instance)",
+                    instance(std::make_shared<PartCylinder>(1.0, -1.0, 1.0, 0.5, 4.0), placement),
+                    false});
+    auto box =
+        std::make_shared<Box>(place - size * Vector3(1, 1, 1), place + size * Vector3(1, 1, 1));
+    auto bite = std::make_shared<Sphere>(place + size * Vector3(1, 1, 1), size);
+    list.push_back({"box - sphere (CSG)", make_difference(box, {bite}), false});
+    for (const bool double_precision : {false, true}) {
+        const std::string precision = double_precision ? " double" : " float";
+        list.push_back({"sphere_mesh(3)" + precision,
+                        mesh_at(test::sphere_mesh(3), placement, double_precision), true});
+        list.push_back(
+            {"sphere_mesh(3)" + precision + " (instance)",
+             instance(mesh_at(test::sphere_mesh(3), Transform(), double_precision), sheared),
+             true});
+    }
+    return list;
+}
+
+/// A direction whose cosine with `axis` (unit) lies in [minimum_cosine, 1].
+Vector3 direction_around(test::Random& random, const Vector3& axis, double minimum_cosine) {
+    for (;;) {
+        const Vector3 d = random.unit_vector();
+        const double cosine = d.dot(axis);
+        if (cosine >= minimum_cosine) return d * random.uniform(0.25, 4.0);
+        if (-cosine >= minimum_cosine) return -d * random.uniform(0.25, 4.0);
+    }
+}
+
+TEST(SecondaryRays, NeverRehitTheSurfaceTheyLeaveWhereverTheSceneIs) {
+    // Rays leave at cosines down to 0.02 with the normal. Besides the rule itself (factor 1),
+    // the point error is shrunk by powers of two to show how much of it is margin: the table
+    // prints the self hits at each fraction.
+    constexpr int kFractions = 10;
+    std::array<long, kFractions> self_hits{};
+    long leaving_rays = 0;
+    test::Random random(20190226);
+    std::printf("\n  | translation | size | rays leaving | self hits at point error x 1 |\n");
+    for (const double translation : kTranslations) {
+        for (const double size : {1e-2, 1.0}) {
+            const Point3 place = translation * kShiftDirection;
+            long rays_here = 0, hits_here = 0;
+            for (const Subject& subject : subjects(place, size)) {
+                const Shape& shape = *subject.shape;
+                const Aabb box = shape.bounds().is_finite() ? shape.bounds()
+                                                            : Aabb(place - Vector3::Constant(size),
+                                                                   place + Vector3::Constant(size));
+                const Point3 camera = place + 6.0 * size * Vector3(0.3, 0.5, -0.8);
+                for (int i = 0; i < 150; ++i) {
+                    const Ray primary{camera, random.in_box(box) - camera};
+                    const std::optional<Hit> hit = shape.intersect(primary);
+                    if (!hit) continue;
+                    const Normal3 toward = primary.direction.dot(hit->geometric_normal) < 0.0
+                                               ? hit->geometric_normal
+                                               : Normal3(-hit->geometric_normal);
+                    for (int k = 0; k < 6; ++k) {
+                        const Vector3 direction = direction_around(random, toward, 0.02);
+                        ++leaving_rays;
+                        ++rays_here;
+                        for (int f = 0; f < kFractions; ++f) {
+                            Hit shrunk = *hit;
+                            shrunk.point_error = std::ldexp(hit->point_error, -f);
+                            const Ray leaving{spawn_ray_origin(shrunk, toward), direction};
+                            const std::optional<Hit> again = shape.intersect(leaving);
+                            if (!again) continue;
+                            // A self hit is the same primitive met again within a few offsets
+                            // of the start; farther ones are real (a torus seen across).
+                            const double reach = 4.0 * spawn_offset_distance(*hit, toward) /
+                                                 std::abs(direction.normalized().dot(toward));
+                            const bool self = again->shape == hit->shape &&
+                                              again->primitive_id == hit->primitive_id &&
+                                              again->t * direction.norm() < reach;
+                            if (!(subject.convex || self)) continue;
+                            ++self_hits[f];
+                            if (f == 0) {
+                                ++hits_here;
+                                ADD_FAILURE()
+                                    << subject.name << " at " << translation << ", size " << size
+                                    << ": re-hit at distance " << again->t * direction.norm()
+                                    << " (error " << hit->point_error << ")";
+                            }
+                        }
+                    }
+                }
+            }
+            std::printf("  | %g | %g | %ld | %ld |\n", translation, size, rays_here, hits_here);
+        }
+    }
+    std::printf("\n  | point error x | self hits (of %ld rays) |\n", leaving_rays);
+    for (int f = 0; f < kFractions; ++f) std::printf("  | 2^-%d | %ld |\n", f, self_hits[f]);
+    EXPECT_EQ(self_hits[0], 0);
+    EXPECT_GT(leaving_rays, 20000);
+}
+
+/// The largest coordinate magnitude of the scene's bounds and camera: what the renderer's
+/// former offset (offset_ray_origin, 2^-16 of it near the origin) was sized by.
+double scene_magnitude(const Scene& scene) {
+    double magnitude = scene.camera().position.cwiseAbs().maxCoeff();
+    const Aabb& bounds = scene.bounds();
+    if (!bounds.is_empty() && bounds.is_finite()) {
+        magnitude = std::max(
+            {magnitude, bounds.lower.cwiseAbs().maxCoeff(), bounds.upper.cwiseAbs().maxCoeff()});
+    }
+    return magnitude;
+}
+
+/// Whether the hit `ray` finds in `scene` is lit by the scene's one point light, with the
+/// renderer's former shadow offset: the "before" column of the tables.
+std::optional<bool> lit_with_former_offset(const Scene& scene, const Ray& ray) {
+    const std::optional<Hit> hit = scene.intersect(ray, thread_query_scratch());
+    if (!hit) return std::nullopt;
+    Normal3 n = hit->geometric_normal;
+    if (n.dot(ray.direction) > 0.0) n = -n;
+    const auto& light = std::get<PointLight>(scene.lights().front());
+    if (!(n.dot(light.position - hit->point) > 0.0)) return false;
+    const Point3 origin = offset_ray_origin(hit->point, n, scene_magnitude(scene));
+    Ray shadow{origin, light.position - origin};
+    shadow.t_max = 1.0 - kRayOffsetRelative;
+    return !scene.occluded(shadow, thread_query_scratch());
+}
+
+/// Thin gaps over a floor: a disk 0.05 above it, a sphere 0.01 above it, a slab 0.002 above
+/// it, lit by one point light, everything moved by `shift`.
+Scene thin_gaps(const Vector3& shift) {
+    Scene scene;
+    scene.add_object(std::make_shared<Box>(shift + Vector3(-4, -1, -4), shift + Vector3(4, 0, 4)),
+                     0, "floor");
+    scene.add_object(
+        std::make_shared<Disk>(shift + Vector3(-1.2, 0.05, 0.3), Normal3(0, 1, 0), 0.6), 0,
+        "disk 0.05 above");
+    scene.add_object(std::make_shared<Sphere>(shift + Vector3(0.6, 0.51, -0.4), 0.5), 0,
+                     "sphere 0.01 above");
+    scene.add_object(
+        std::make_shared<Box>(shift + Vector3(0.4, 0.002, 0.8), shift + Vector3(1.6, 0.012, 1.6)),
+        0, "slab 0.002 above");
+    // Low, so that shadows reach out from under their casters where the camera sees them.
+    scene.add_light(PointLight{shift + Vector3(5.0, 1.5, 2.0), Vector3(100, 100, 100)});
+    Camera camera;
+    camera.position = shift + Vector3(0.0, 3.0, 6.0);
+    camera.look_at = shift + Vector3(0.0, 0.0, 0.0);
+    camera.vertical_fov_degrees = 45.0;
+    scene.set_camera(camera);
+    scene.commit();
+    return scene;
+}
+
+TEST(SecondaryRays, AMovedSceneShadowsTheSamePixelsAndKeepsItsThinGaps) {
+    RenderSettings settings;
+    settings.width = 64;
+    settings.height = 48;
+    settings.threads = 1;
+    const Scene at_origin = thin_gaps(Vector3::Zero());
+    const RenderResult reference = render(at_origin, settings);
+    long shadowed_floor = 0;
+    for (int y = 0; y < settings.height; ++y) {
+        for (int x = 0; x < settings.width; ++x) {
+            const Pixel& p = reference.image.at(x, y);
+            if (p.object_id == 0 && p.alpha > 0.0f && p.red == 0.0f) ++shadowed_floor;
+        }
+    }
+    // The three thin objects cast shadows on the floor at the origin (independently of any
+    // offset: 0.002 is 10^9 of the point error there).
+    ASSERT_GT(shadowed_floor, 100);
+    std::printf(
+        "\n  | translation | pixels whose lit/shadowed state differs from the origin's:"
+        " former offset | point-error offset (renderer) |\n");
+    for (const double translation : kTranslations) {
+        const Scene moved = thin_gaps(translation * kShiftDirection);
+        const RenderResult result = render(moved, settings);
+        const CameraFilm film(moved.camera(), double(settings.width) / settings.height);
+        long differing = 0, differing_before = 0;
+        for (int y = 0; y < settings.height; ++y) {
+            for (int x = 0; x < settings.width; ++x) {
+                const Pixel& expected = reference.image.at(x, y);
+                const Pixel& got = result.image.at(x, y);
+                ASSERT_EQ(got.object_id, expected.object_id) << x << ", " << y;
+                const bool lit = expected.red > 0.0f;
+                if ((got.red > 0.0f) != lit) ++differing;
+                const std::optional<bool> before = lit_with_former_offset(
+                    moved, film.ray((x + 0.5) / settings.width, (y + 0.5) / settings.height));
+                if (before.has_value() && *before != lit) ++differing_before;
+            }
+        }
+        std::printf("  | %g | %ld | %ld |\n", translation, differing_before, differing);
+        EXPECT_EQ(differing, 0) << "translation " << translation;
+    }
+}
+
+/// Long-double intervals of a line o + t d inside an axis-aligned box (empty: lo > hi), and
+/// the t where each slab is entered (to tell which face is crossed and whether two tie).
+struct BoxCrossing {
+    long double lo = -1e4000L, hi = 1e4000L;
+    int axis = -1;
+    long double second_entry = -1e4000L;
+};
+
+using Vec3L = Eigen::Matrix<long double, 3, 1>;
+
+BoxCrossing cross_box(const Vec3L& o, const Vec3L& d, const Vec3L& lower, const Vec3L& upper) {
+    BoxCrossing c;
+    for (int axis = 0; axis < 3; ++axis) {
+        long double t0 = (lower[axis] - o[axis]) / d[axis];
+        long double t1 = (upper[axis] - o[axis]) / d[axis];
+        if (t0 > t1) std::swap(t0, t1);
+        if (t0 > c.lo) {
+            c.second_entry = c.lo;
+            c.lo = t0;
+            c.axis = axis;
+        } else {
+            c.second_entry = std::max(c.second_entry, t0);
+        }
+        c.hi = std::min(c.hi, t1);
+    }
+    return c;
+}
+
+/// The cavity scene: a box with a spherical dish cut into its top face, a point light just
+/// above the rim, so that light grazes the dish and the top face, and the rim shadows part of
+/// the dish.
+struct Cavity {
+    Vec3L lower{-2.0L, -1.0L, -2.0L}, upper{2.0L, 0.0L, 2.0L};
+    Vec3L centre{0.0L, 0.5L, 0.0L};
+    long double radius = 1.2L;
+    Point3 light{-1.3, 0.05, 0.1};
+
+    /// The intervals of the line o + t d inside box minus ball, at most two, and the events.
+    struct Along {
+        std::vector<std::array<long double, 2>> inside;
+        std::vector<long double> events;
+    };
+    Along along(const Vec3L& o, const Vec3L& d) const {
+        Along result;
+        const BoxCrossing box = cross_box(o, d, lower, upper);
+        if (!(box.lo < box.hi)) return result;
+        const Vec3L f = o - centre;
+        const long double a = d.squaredNorm(), b = f.dot(d), c = f.squaredNorm() - radius * radius;
+        const long double disc = b * b - a * c;
+        result.events = {box.lo, box.hi, box.second_entry};
+        if (disc <= 0.0L) {
+            result.inside.push_back({box.lo, box.hi});
+            return result;
+        }
+        const long double root = std::sqrt(disc);
+        const long double t0 = (-b - root) / a, t1 = (-b + root) / a;
+        result.events.push_back(t0);
+        result.events.push_back(t1);
+        if (box.lo < std::min(t0, box.hi)) result.inside.push_back({box.lo, std::min(t0, box.hi)});
+        if (std::max(t1, box.lo) < box.hi) result.inside.push_back({std::max(t1, box.lo), box.hi});
+        return result;
+    }
+};
+
+enum class Verdict { kMiss, kLit, kDark, kAmbiguous };
+
+/// The exact (long double) answer for a camera ray: its hit on the cavity solid and whether the
+/// light reaches it. kAmbiguous within `band` (relative) of an edge, a tangent or a shadow edge.
+Verdict reference_verdict(const Cavity& cavity, const Ray& ray) {
+    constexpr long double band = 1e-9L;
+    const Vec3L o = ray.origin.cast<long double>(), d = ray.direction.cast<long double>();
+    const Cavity::Along primary = cavity.along(o, d);
+    if (primary.inside.empty()) return Verdict::kMiss;
+    const long double t = primary.inside.front()[0];
+    if (!(t > 0.0L)) return Verdict::kMiss;
+    for (long double event : primary.events) {
+        if (event != t && std::abs(event - t) < band * (1.0L + std::abs(t))) {
+            return Verdict::kAmbiguous;
+        }
+    }
+    const Vec3L p = o + t * d;
+    Vec3L n;
+    const BoxCrossing box = cross_box(o, d, cavity.lower, cavity.upper);
+    if (t == box.lo) {
+        n = Vec3L::Zero();
+        n[box.axis] = d[box.axis] > 0.0L ? -1.0L : 1.0L;
+    } else {
+        n = (cavity.centre - p) / cavity.radius;  // the dish faces into the ball
+    }
+    const Vec3L l = cavity.light.cast<long double>() - p;
+    const long double cosine = n.dot(l) / l.norm();
+    if (std::abs(cosine) < band) return Verdict::kAmbiguous;
+    if (cosine < 0.0L) return Verdict::kDark;
+    const Cavity::Along shadow = cavity.along(p, l);
+    Verdict verdict = Verdict::kLit;
+    for (const auto& [start, end] : shadow.inside) {
+        if (std::abs(end) < band) continue;  // the surface the point is on, behind it
+        const long double overlap = std::min(end, 1.0L) - std::max(start, 0.0L);
+        if (std::abs(overlap) < band || end - start < band) return Verdict::kAmbiguous;
+        if (overlap > 0.0L) verdict = Verdict::kDark;
+    }
+    return verdict;
+}
+
+TEST(SecondaryRays, GrazingLightInAConcaveCavityMatchesALongDoubleReference) {
+    const Cavity cavity;
+    RenderSettings settings;
+    settings.width = 48;
+    settings.height = 48;
+    settings.threads = 1;
+    std::printf(
+        "\n  | translation | pixels | lit | dark | ambiguous (within 1e-9) |"
+        " disagreements: former offset | point-error offset (renderer) |\n");
+    for (const double translation : {0.0, 1e4}) {
+        // The reference is computed for the scene at the origin with the moved scene's rays
+        // moved back: the same geometry, exactly.
+        const Vector3 shift = translation * kShiftDirection;
+        Scene scene;
+        auto box = std::make_shared<Box>(shift + cavity.lower.cast<double>(),
+                                         shift + cavity.upper.cast<double>());
+        auto ball =
+            std::make_shared<Sphere>(shift + cavity.centre.cast<double>(), double(cavity.radius));
+        scene.add_object(make_difference(box, {ball}), 0, "dish");
+        scene.add_light(PointLight{shift + cavity.light, Vector3(10, 10, 10)});
+        Camera camera;
+        camera.position = shift + Vector3(0.9, 3.0, 1.6);
+        camera.look_at = shift + Vector3(-0.2, -0.3, 0.0);
+        camera.vertical_fov_degrees = 50.0;
+        scene.set_camera(camera);
+        scene.commit();
+        const RenderResult result = render(scene, settings);
+        const CameraFilm film(scene.camera(), 1.0);
+        long lit = 0, dark = 0, ambiguous = 0, wrong = 0, wrong_before = 0;
+        for (int y = 0; y < settings.height; ++y) {
+            for (int x = 0; x < settings.width; ++x) {
+                const Ray ray = film.ray((x + 0.5) / settings.width, (y + 0.5) / settings.height);
+                // Moving the origin back by `shift` rounds it; at 10^4 that is 2^-40 and far
+                // inside the ambiguity band.
+                const Ray at_origin{ray.origin - shift, ray.direction};
+                const Verdict verdict = reference_verdict(cavity, at_origin);
+                const Pixel& pixel = result.image.at(x, y);
+                if (verdict == Verdict::kAmbiguous) {
+                    ++ambiguous;
+                    continue;
+                }
+                ASSERT_EQ(pixel.alpha > 0.0f, verdict != Verdict::kMiss) << x << ", " << y;
+                if (verdict == Verdict::kMiss) continue;
+                const bool expected_lit = verdict == Verdict::kLit;
+                (expected_lit ? lit : dark) += 1;
+                if ((pixel.red > 0.0f) != expected_lit) {
+                    ++wrong;
+                    ADD_FAILURE() << "pixel " << x << ", " << y << " at translation " << translation
+                                  << ": expected " << (expected_lit ? "lit" : "dark");
+                }
+                const std::optional<bool> before = lit_with_former_offset(scene, ray);
+                if (before.has_value() && *before != expected_lit) ++wrong_before;
+            }
+        }
+        std::printf("  | %g | %d | %ld | %ld | %ld | %ld | %ld |\n", translation,
+                    settings.width * settings.height, lit, dark, ambiguous, wrong_before, wrong);
+        // Light must graze: both verdicts occur on the dish.
+        EXPECT_GT(lit, 200);
+        EXPECT_GT(dark, 100);
+    }
+}
+
+}  // namespace
+}  // namespace csgrt
