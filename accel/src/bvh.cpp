@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <limits>
 #include <new>
+#include <optional>
 #include <span>
 #include <type_traits>
 
@@ -117,29 +118,60 @@ namespace detail {
 /// use (1 - slack) / d, far planes (1 + slack) / d. Otherwise (`signed_interval`) the
 /// traversal widens each interval by its magnitude.
 struct BoxRay {
-    float origin[3];
-    float inverse_near[3];
-    float inverse_far[3];
+    // Lane 3 of each is padding (written as four floats at once).
+    float origin[4];
+    float inverse_near[4];
+    float inverse_far[4];
     /// Whether the direction's sign bit is set (-0 included): the box's upper face is then
     /// the near one, and the products below never form 0 * inf except in a face's plane.
     bool negative[3];
     bool signed_interval;
     float t_min;
 
-    explicit BoxRay(const Ray& ray) {
+    // Inlined into the query: it runs once a ray, and most camera rays never reach a leaf.
+    // With SSE2 the representability test and the reciprocals take the components two and
+    // four at a time (divps and cvtpd2ps round lane by lane exactly as divss and cvtsd2ss do),
+    // and the common case of round_down (t_min a float: 0 or -inf) is taken first.
+    [[gnu::always_inline]] explicit BoxRay(const Ray& ray) {
+        const float t_min_float = static_cast<float>(ray.t_min);
+        t_min = double(t_min_float) <= ray.t_min && t_min_float != kFloatInfinity
+                    ? t_min_float
+                    : round_down(ray.t_min);
+        signed_interval = !(t_min >= 0.0f);
+#if defined(__SSE2__)
+        const double* o = ray.origin.data();
+        const double* d = ray.direction.data();
+        // (o0, o1), (o2, d0), (d1, d2).
+        const __m128d v0 = _mm_loadu_pd(o), v1 = _mm_set_pd(d[0], o[2]), v2 = _mm_loadu_pd(d + 1);
+        const __m128d sign = _mm_set1_pd(-0.0), zero = _mm_setzero_pd();
+        const __m128d largest = _mm_set1_pd(kLargestBoxRayValue);
+        const __m128d smallest = _mm_set1_pd(1.0 / kLargestBoxRayValue);
+        const __m128d a0 = _mm_andnot_pd(sign, v0), a1 = _mm_andnot_pd(sign, v1),
+                      a2 = _mm_andnot_pd(sign, v2);
+        // Every |component| <= 2^100 (false for NaN); each direction component 0 or >= 2^-100.
+        const __m128d small_ok1 =
+            _mm_or_pd(_mm_or_pd(_mm_cmpge_pd(a1, smallest), _mm_cmpeq_pd(v1, zero)),
+                      _mm_castsi128_pd(_mm_set_epi32(0, 0, -1, -1)));
+        const __m128d small_ok2 = _mm_or_pd(_mm_cmpge_pd(a2, smallest), _mm_cmpeq_pd(v2, zero));
+        const __m128d ok = _mm_and_pd(
+            _mm_and_pd(_mm_cmple_pd(a0, largest), _mm_and_pd(_mm_cmple_pd(a1, largest), small_ok1)),
+            _mm_and_pd(_mm_cmple_pd(a2, largest), small_ok2));
+        const bool representable = _mm_movemask_pd(ok) == 3;
+        const int signs = _mm_movemask_pd(v1) >> 1 | _mm_movemask_pd(v2) << 1;
+        for (int axis = 0; axis < 3; ++axis) negative[axis] = (signs >> axis) & 1;
+#else
         bool representable = true;
         for (int axis = 0; axis < 3; ++axis) {
-            const double d = ray.direction[axis];
-            representable &= std::abs(ray.origin[axis]) <= kLargestBoxRayValue &&
-                             (d == 0.0 || (std::abs(d) <= kLargestBoxRayValue &&
-                                           std::abs(d) >= 1.0 / kLargestBoxRayValue));
+            const double d = ray.direction[axis], magnitude = std::abs(d);
+            representable &= (std::abs(ray.origin[axis]) <= kLargestBoxRayValue) &
+                             ((d == 0.0) | ((magnitude <= kLargestBoxRayValue) &
+                                            (magnitude >= 1.0 / kLargestBoxRayValue)));
             negative[axis] = std::signbit(d);
         }
-        t_min = round_down(ray.t_min);
-        signed_interval = !(t_min >= 0.0f);
-        if (!representable) {
+#endif
+        if (!representable) [[unlikely]] {
             // Every slab distance becomes NaN, which the tests ignore: every box is entered.
-            for (int axis = 0; axis < 3; ++axis) {
+            for (int axis = 0; axis < 4; ++axis) {
                 origin[axis] = 0.0f;
                 inverse_near[axis] = inverse_far[axis] = std::numeric_limits<float>::quiet_NaN();
             }
@@ -149,6 +181,18 @@ struct BoxRay {
         }
         const float near_scale = signed_interval ? 1.0f : 1.0f - kSlack;
         const float far_scale = signed_interval ? 1.0f : 1.0f + kSlack;
+#if defined(__SSE2__)
+        // Lane 3 is padding: origin 0, direction 1.
+        const __m128 origin4 = _mm_movelh_ps(_mm_cvtpd_ps(v0), _mm_cvtpd_ps(_mm_move_sd(zero, v1)));
+        const __m128 direction4 =
+            _mm_movelh_ps(_mm_cvtpd_ps(_mm_shuffle_pd(v1, v2, 1)),
+                          _mm_cvtpd_ps(_mm_unpackhi_pd(v2, _mm_set1_pd(1.0))));
+        // +-0 gives +-inf, whose products with plane distances are +-inf or NaN.
+        const __m128 inverse = _mm_div_ps(_mm_set1_ps(1.0f), direction4);
+        _mm_storeu_ps(origin, origin4);
+        _mm_storeu_ps(inverse_near, _mm_mul_ps(inverse, _mm_set1_ps(near_scale)));
+        _mm_storeu_ps(inverse_far, _mm_mul_ps(inverse, _mm_set1_ps(far_scale)));
+#else
         for (int axis = 0; axis < 3; ++axis) {
             origin[axis] = static_cast<float>(ray.origin[axis]);
             // +-0 gives +-inf, whose products with plane distances are +-inf or NaN.
@@ -156,6 +200,7 @@ struct BoxRay {
             inverse_near[axis] = inverse * near_scale;
             inverse_far[axis] = inverse * far_scale;
         }
+#endif
     }
     /// Offsets (in floats) of the rows of WideBvhNode<kWidth>::bounds that hold each axis'
     /// near and far planes.
@@ -667,12 +712,16 @@ struct BvhTraversal {
     static bool intersect(const Tree& bvh, const Ray& ray, HitRecord& record, QueryScratch& scratch,
                           TraversalCounters& counters) {
         if (bvh.set_ == nullptr || !is_valid(ray)) return false;
-        const LeafRay leaf_ray(*bvh.set_, ray, scratch);
+        // The leaf ray is made at the first leaf: most camera rays reach none (they miss the
+        // mesh's boxes), and for them the set's prepare and the block ray are pure cost.
+        std::optional<LeafRay> leaf_ray;
         HitRecord best;
         best.t = ray.t_max;
         bool found = false;
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
-            found |= nearest_in_leaf<kCount>(bvh, leaf_ray, first, count, best, t_max, counters);
+            if (!leaf_ray) [[unlikely]]
+                leaf_ray.emplace(*bvh.set_, ray, scratch);
+            found |= nearest_in_leaf<kCount>(bvh, *leaf_ray, first, count, best, t_max, counters);
             return false;
         };
         traverse<kCount>(bvh, ray, counters, leaf);
@@ -684,6 +733,8 @@ struct BvhTraversal {
     static bool occluded(const Tree& bvh, const Ray& ray, QueryScratch& scratch,
                          TraversalCounters& counters) {
         if (bvh.set_ == nullptr || !is_valid(ray)) return false;
+        // Made up front, unlike intersect's: shadow rays start on a surface and nearly all
+        // reach a leaf, and the deferred form cost them 58 instructions a ray (callgrind).
         const LeafRay leaf_ray(*bvh.set_, ray, scratch);
         bool occluded = false;
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
