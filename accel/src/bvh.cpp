@@ -9,6 +9,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <new>
+#include <optional>
+#include <span>
 #include <type_traits>
 
 #include "accelerator_base.h"
@@ -116,29 +119,60 @@ namespace detail {
 /// use (1 - slack) / d, far planes (1 + slack) / d. Otherwise (`signed_interval`) the
 /// traversal widens each interval by its magnitude.
 struct BoxRay {
-    float origin[3];
-    float inverse_near[3];
-    float inverse_far[3];
+    // Lane 3 of each is padding (written as four floats at once).
+    float origin[4];
+    float inverse_near[4];
+    float inverse_far[4];
     /// Whether the direction's sign bit is set (-0 included): the box's upper face is then
     /// the near one, and the products below never form 0 * inf except in a face's plane.
     bool negative[3];
     bool signed_interval;
     float t_min;
 
-    explicit BoxRay(const Ray& ray) {
+    // Inlined into the query: it runs once a ray, and most camera rays never reach a leaf.
+    // With SSE2 the representability test and the reciprocals take the components two and
+    // four at a time (divps and cvtpd2ps round lane by lane exactly as divss and cvtsd2ss do),
+    // and the common case of round_down (t_min a float: 0 or -inf) is taken first.
+    [[gnu::always_inline]] explicit BoxRay(const Ray& ray) {
+        const float t_min_float = static_cast<float>(ray.t_min);
+        t_min = double(t_min_float) <= ray.t_min && t_min_float != kFloatInfinity
+                    ? t_min_float
+                    : round_down(ray.t_min);
+        signed_interval = !(t_min >= 0.0f);
+#if defined(__SSE2__)
+        const double* o = ray.origin.data();
+        const double* d = ray.direction.data();
+        // (o0, o1), (o2, d0), (d1, d2).
+        const __m128d v0 = _mm_loadu_pd(o), v1 = _mm_set_pd(d[0], o[2]), v2 = _mm_loadu_pd(d + 1);
+        const __m128d sign = _mm_set1_pd(-0.0), zero = _mm_setzero_pd();
+        const __m128d largest = _mm_set1_pd(kLargestBoxRayValue);
+        const __m128d smallest = _mm_set1_pd(1.0 / kLargestBoxRayValue);
+        const __m128d a0 = _mm_andnot_pd(sign, v0), a1 = _mm_andnot_pd(sign, v1),
+                      a2 = _mm_andnot_pd(sign, v2);
+        // Every |component| <= 2^100 (false for NaN); each direction component 0 or >= 2^-100.
+        const __m128d small_ok1 =
+            _mm_or_pd(_mm_or_pd(_mm_cmpge_pd(a1, smallest), _mm_cmpeq_pd(v1, zero)),
+                      _mm_castsi128_pd(_mm_set_epi32(0, 0, -1, -1)));
+        const __m128d small_ok2 = _mm_or_pd(_mm_cmpge_pd(a2, smallest), _mm_cmpeq_pd(v2, zero));
+        const __m128d ok = _mm_and_pd(
+            _mm_and_pd(_mm_cmple_pd(a0, largest), _mm_and_pd(_mm_cmple_pd(a1, largest), small_ok1)),
+            _mm_and_pd(_mm_cmple_pd(a2, largest), small_ok2));
+        const bool representable = _mm_movemask_pd(ok) == 3;
+        const int signs = _mm_movemask_pd(v1) >> 1 | _mm_movemask_pd(v2) << 1;
+        for (int axis = 0; axis < 3; ++axis) negative[axis] = (signs >> axis) & 1;
+#else
         bool representable = true;
         for (int axis = 0; axis < 3; ++axis) {
-            const double d = ray.direction[axis];
-            representable &= std::abs(ray.origin[axis]) <= kLargestBoxRayValue &&
-                             (d == 0.0 || (std::abs(d) <= kLargestBoxRayValue &&
-                                           std::abs(d) >= 1.0 / kLargestBoxRayValue));
+            const double d = ray.direction[axis], magnitude = std::abs(d);
+            representable &= (std::abs(ray.origin[axis]) <= kLargestBoxRayValue) &
+                             ((d == 0.0) | ((magnitude <= kLargestBoxRayValue) &
+                                            (magnitude >= 1.0 / kLargestBoxRayValue)));
             negative[axis] = std::signbit(d);
         }
-        t_min = round_down(ray.t_min);
-        signed_interval = !(t_min >= 0.0f);
-        if (!representable) {
+#endif
+        if (!representable) [[unlikely]] {
             // Every slab distance becomes NaN, which the tests ignore: every box is entered.
-            for (int axis = 0; axis < 3; ++axis) {
+            for (int axis = 0; axis < 4; ++axis) {
                 origin[axis] = 0.0f;
                 inverse_near[axis] = inverse_far[axis] = std::numeric_limits<float>::quiet_NaN();
             }
@@ -148,6 +182,18 @@ struct BoxRay {
         }
         const float near_scale = signed_interval ? 1.0f : 1.0f - kSlack;
         const float far_scale = signed_interval ? 1.0f : 1.0f + kSlack;
+#if defined(__SSE2__)
+        // Lane 3 is padding: origin 0, direction 1.
+        const __m128 origin4 = _mm_movelh_ps(_mm_cvtpd_ps(v0), _mm_cvtpd_ps(_mm_move_sd(zero, v1)));
+        const __m128 direction4 =
+            _mm_movelh_ps(_mm_cvtpd_ps(_mm_shuffle_pd(v1, v2, 1)),
+                          _mm_cvtpd_ps(_mm_unpackhi_pd(v2, _mm_set1_pd(1.0))));
+        // +-0 gives +-inf, whose products with plane distances are +-inf or NaN.
+        const __m128 inverse = _mm_div_ps(_mm_set1_ps(1.0f), direction4);
+        _mm_storeu_ps(origin, origin4);
+        _mm_storeu_ps(inverse_near, _mm_mul_ps(inverse, _mm_set1_ps(near_scale)));
+        _mm_storeu_ps(inverse_far, _mm_mul_ps(inverse, _mm_set1_ps(far_scale)));
+#else
         for (int axis = 0; axis < 3; ++axis) {
             origin[axis] = static_cast<float>(ray.origin[axis]);
             // +-0 gives +-inf, whose products with plane distances are +-inf or NaN.
@@ -155,6 +201,7 @@ struct BoxRay {
             inverse_near[axis] = inverse * near_scale;
             inverse_far[axis] = inverse * far_scale;
         }
+#endif
     }
     /// Offsets (in floats) of the rows of WideBvhNode<kWidth>::bounds that hold each axis'
     /// near and far planes.
@@ -558,85 +605,124 @@ struct BvhTraversal {
         }
     }
 
-    /// Calls visit(primitive) for each primitive of an index leaf, until it returns true.
-    template <class Visit>
-    static bool for_each_primitive(const Tree& bvh, std::uint32_t first, std::uint32_t count,
-                                   Visit&& visit) {
-        if (count == 1) return visit(first);
+    /// A ray as the leaves test it: the set's prepared ray and, for block leaves, its SIMD
+    /// form, made once per query.
+    struct NoBlockRay {
+        explicit NoBlockRay(const typename Set::PreparedRay&) {}
+    };
+    using LeafBlockRay = std::conditional_t<kBlockSet, BlockRay, NoBlockRay>;
+    struct LeafRay {
+        typename Set::PreparedRay prepared;
+        LeafBlockRay block;
+
+        LeafRay(const Set& set, const Ray& ray, QueryScratch& scratch)
+            : prepared(set.prepare(ray, scratch)), block(prepared) {}
+    };
+
+    /// A triangle of a block that the set's test reports as hit on the ray's line, at t with
+    /// the barycentrics b1, b2 of corners 1 and 2.
+    struct BlockCandidate {
+        std::uint32_t index;
+        double t, b1, b2;
+        const typename Set::PreparedRay& ray;
+
+        bool keep_nearest(HitRecord& record) const {
+            return Set::keep_nearest(index, t, b1, b2, ray, record);
+        }
+        bool occludes() const { return t >= ray.t_min && t <= ray.t_max; }
+    };
+    /// A primitive of an index leaf, not yet tested: the set's own queries test it.
+    struct PrimitiveCandidate {
+        const Set& set;
+        std::uint32_t index;
+        const typename Set::PreparedRay& ray;
+
+        bool keep_nearest(HitRecord& record) const { return set.intersect(index, ray, record); }
+        bool occludes() const { return set.occluded(index, ray); }
+    };
+
+    /// Calls visit(candidate) for each primitive of the leaf (first, count) that may be hit,
+    /// until it returns true; returns whether it did. A candidate answers keep_nearest(record)
+    /// (the set's intersect: the hit in [t_min, record.t] that beats record under the tie
+    /// rule) and occludes() (the set's occluded). Block leaves test four triangles at once and
+    /// hand on only those hit on the ray's line; index leaves hand on every primitive.
+    template <bool kCount, class Visit>
+    static bool for_each_hit(const Tree& bvh, const LeafRay& ray, std::uint32_t first,
+                             std::uint32_t count, TraversalCounters& counters, Visit&& visit) {
+        if constexpr (kBlockSet) {
+            if (!bvh.blocks_.empty()) {
+                const BvhTriangleBlock* block = bvh.blocks_.data() + first;
+                for (std::uint32_t left = count; left != 0; ++block) {
+                    const std::uint32_t lanes = std::min(left, kBlockLanes);
+                    left -= lanes;
+                    if constexpr (kCount) counters.primitives_tested += lanes;
+                    ShearedBlock sheared;
+                    unsigned candidates =
+                        ray.block.candidates(*block, sheared) & ((1u << lanes) - 1u);
+                    while (candidates != 0) {
+                        const int lane = std::countr_zero(candidates);
+                        candidates &= candidates - 1;
+                        double t, b1, b2;
+                        if (TriangleSet<float>::hit_sheared(sheared.lane(lane),
+                                                            ray.prepared.shear_z, t, b1, b2) &&
+                            visit(BlockCandidate{block->primitive[lane], t, b1, b2,
+                                                 ray.prepared})) {
+                            return true;
+                        }
+                    }
+                }
+                return false;
+            }
+        }
+        const Set& set = *bvh.set_;
+        if (count == 1) {
+            if constexpr (kCount) ++counters.primitives_tested;
+            return visit(PrimitiveCandidate{set, first, ray.prepared});
+        }
         const std::uint32_t* indices = bvh.indices_.data() + first;
         for (std::uint32_t i = 0; i != count; ++i) {
-            if (visit(indices[i])) return true;
+            if constexpr (kCount) ++counters.primitives_tested;
+            if (visit(PrimitiveCandidate{set, indices[i], ray.prepared})) return true;
         }
         return false;
     }
 
-    /// Calls visit(index, t, b1, b2) for each triangle of a block leaf that the set's test
-    /// reports as hit (anywhere on the line), until it returns true.
-    template <class Visit>
-    static bool for_each_block_hit(const Tree& bvh, const BlockRay& block_ray, double shear_z,
-                                   std::uint32_t first, std::uint32_t count, Visit&& visit) {
-        const BvhTriangleBlock* block = bvh.blocks_.data() + first;
-        for (std::uint32_t left = count; left != 0; ++block) {
-            const std::uint32_t lanes = std::min(left, kBlockLanes);
-            left -= lanes;
-            ShearedBlock sheared;
-            unsigned candidates = block_ray.candidates(*block, sheared) & ((1u << lanes) - 1u);
-            while (candidates != 0) {
-                const int lane = std::countr_zero(candidates);
-                candidates &= candidates - 1;
-                double t, b1, b2;
-                if (TriangleSet<float>::hit_sheared(sheared.lane(lane), shear_z, t, b1, b2) &&
-                    visit(block->primitive[lane], t, b1, b2)) {
-                    return true;
-                }
-            }
-        }
-        return false;
+    /// The nearest-hit leaf test: keeps the leaf's best hit in `best` and lowers t_max to it.
+    template <bool kCount>
+    static bool nearest_in_leaf(const Tree& bvh, const LeafRay& ray, std::uint32_t first,
+                                std::uint32_t count, HitRecord& best, float& t_max,
+                                TraversalCounters& counters) {
+        bool hit = false;
+        for_each_hit<kCount>(bvh, ray, first, count, counters, [&](const auto& candidate) {
+            hit |= candidate.keep_nearest(best);
+            return false;
+        });
+        if (hit) t_max = round_up(best.t);
+        return hit;
+    }
+
+    /// The occlusion leaf test: whether any primitive of the leaf is hit in [t_min, t_max].
+    template <bool kCount>
+    static bool occluded_in_leaf(const Tree& bvh, const LeafRay& ray, std::uint32_t first,
+                                 std::uint32_t count, TraversalCounters& counters) {
+        return for_each_hit<kCount>(bvh, ray, first, count, counters,
+                                    [](const auto& candidate) { return candidate.occludes(); });
     }
 
     template <bool kCount>
     static bool intersect(const Tree& bvh, const Ray& ray, HitRecord& record, QueryScratch& scratch,
                           TraversalCounters& counters) {
         if (bvh.set_ == nullptr || !is_valid(ray)) return false;
-        const Set& set = *bvh.set_;
-        const auto prepared = set.prepare(ray, scratch);
+        // The leaf ray is made at the first leaf: most camera rays reach none (they miss the
+        // mesh's boxes), and for them the set's prepare and the block ray are pure cost.
+        std::optional<LeafRay> leaf_ray;
         HitRecord best;
         best.t = ray.t_max;
         bool found = false;
-        if constexpr (kBlockSet) {
-            if (!bvh.blocks_.empty()) {
-                const BlockRay block_ray(prepared);
-                auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
-                    if constexpr (kCount) counters.primitives_tested += count;
-                    bool hit = false;
-                    for_each_block_hit(bvh, block_ray, prepared.shear_z, first, count,
-                                       [&](std::uint32_t index, double t, double b1, double b2) {
-                                           hit |=
-                                               Set::keep_nearest(index, t, b1, b2, prepared, best);
-                                           return false;
-                                       });
-                    if (hit) {
-                        found = true;
-                        t_max = round_up(best.t);
-                    }
-                    return false;
-                };
-                traverse<kCount>(bvh, ray, counters, leaf);
-                if (found) record = best;
-                return found;
-            }
-        }
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
-            if constexpr (kCount) counters.primitives_tested += count;
-            bool hit = false;
-            for_each_primitive(bvh, first, count, [&](std::uint32_t i) {
-                hit |= set.intersect(i, prepared, best);
-                return false;
-            });
-            if (hit) {
-                found = true;
-                t_max = round_up(best.t);
-            }
+            if (!leaf_ray) [[unlikely]]
+                leaf_ray.emplace(*bvh.set_, ray, scratch);
+            found |= nearest_in_leaf<kCount>(bvh, *leaf_ray, first, count, best, t_max, counters);
             return false;
         };
         traverse<kCount>(bvh, ray, counters, leaf);
@@ -648,29 +734,12 @@ struct BvhTraversal {
     static bool occluded(const Tree& bvh, const Ray& ray, QueryScratch& scratch,
                          TraversalCounters& counters) {
         if (bvh.set_ == nullptr || !is_valid(ray)) return false;
-        const Set& set = *bvh.set_;
-        const auto prepared = set.prepare(ray, scratch);
+        // Made up front, unlike intersect's: shadow rays start on a surface and nearly all
+        // reach a leaf, and the deferred form cost them 58 instructions a ray (callgrind).
+        const LeafRay leaf_ray(*bvh.set_, ray, scratch);
         bool occluded = false;
-        if constexpr (kBlockSet) {
-            if (!bvh.blocks_.empty()) {
-                const BlockRay block_ray(prepared);
-                auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
-                    if constexpr (kCount) counters.primitives_tested += count;
-                    return occluded = for_each_block_hit(
-                               bvh, block_ray, prepared.shear_z, first, count,
-                               [&](std::uint32_t, double t, double, double) {
-                                   return t >= prepared.t_min && t <= prepared.t_max;
-                               });
-                };
-                traverse<kCount>(bvh, ray, counters, leaf);
-                return occluded;
-            }
-        }
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
-            return occluded = for_each_primitive(bvh, first, count, [&](std::uint32_t i) {
-                       if constexpr (kCount) ++counters.primitives_tested;
-                       return set.occluded(i, prepared);
-                   });
+            return occluded = occluded_in_leaf<kCount>(bvh, leaf_ray, first, count, counters);
         };
         traverse<kCount>(bvh, ray, counters, leaf);
         return occluded;
@@ -679,36 +748,169 @@ struct BvhTraversal {
     static void all_hits(const Tree& bvh, const Ray& ray, std::vector<HitRecord>& hits,
                          QueryScratch& scratch) {
         if (bvh.set_ == nullptr || !is_valid(ray)) return;
-        const Set& set = *bvh.set_;
-        const auto prepared = set.prepare(ray, scratch);
+        const LeafRay leaf_ray(*bvh.set_, ray, scratch);
         TraversalCounters unused;
-        if constexpr (kBlockSet) {
-            if (!bvh.blocks_.empty()) {
-                const BlockRay block_ray(prepared);
-                auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
-                    return for_each_block_hit(
-                        bvh, block_ray, prepared.shear_z, first, count,
-                        [&](std::uint32_t index, double t, double b1, double b2) {
-                            HitRecord record;
-                            record.t = ray.t_max;
-                            if (Set::keep_nearest(index, t, b1, b2, prepared, record))
-                                hits.push_back(record);
-                            return false;
-                        });
-                };
-                traverse<false>(bvh, ray, unused, leaf);
-                return;
-            }
-        }
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
-            return for_each_primitive(bvh, first, count, [&](std::uint32_t i) {
-                HitRecord record;
-                record.t = ray.t_max;
-                if (set.intersect(i, prepared, record)) hits.push_back(record);
-                return false;
-            });
+            return for_each_hit<false>(bvh, leaf_ray, first, count, unused,
+                                       [&](const auto& candidate) {
+                                           HitRecord record;
+                                           record.t = ray.t_max;
+                                           if (candidate.keep_nearest(record))
+                                               hits.push_back(record);
+                                           return false;
+                                       });
         };
         traverse<false>(bvh, ray, unused, leaf);
+    }
+
+    /// One ray of a packet: its node test, its leaf ray and the float upper bound of its
+    /// interval, as the single-ray traversal keeps them.
+    template <class NodeTest>
+    struct PacketLane {
+        BoxRay box;
+        NodeTest test;
+        LeafRay leaf;
+        float t_max;
+
+        PacketLane(const Set& set, const Ray& ray, QueryScratch& scratch)
+            : box(ray), test(box), leaf(set, ray, scratch), t_max(round_up(ray.t_max)) {}
+    };
+    struct PacketEntry {
+        std::uint32_t first;
+        std::uint32_t count;
+        /// The rays that entered the child (bit r for ray r) and the least of their entries.
+        std::uint32_t rays;
+        float t_enter;
+    };
+
+    /// Traverses the wide tree once for up to kPacketRays rays: every node is tested against
+    /// each ray that entered it, exactly as the single-ray traversal tests it (same node test,
+    /// same t_max), and a ray enters a child only when its own test says so; a leaf is tested
+    /// for each ray that entered it. A ray thus tests every primitive its single-ray traversal
+    /// may need (the culling is the single-ray culling, only its order differs), and the tie
+    /// rule of the set makes the nearest hit independent of the order: the answers are the
+    /// single-ray answers bit for bit. Children are visited nearest first by the least entry
+    /// of the rays that entered them. kAny: occlusion (occluded[r]); else nearest hits (best[r],
+    /// found[r]). Invalid rays are left out.
+    template <bool kAny, class NodeTest, int kWidth>
+    static void traverse_packet(const Tree& bvh, const WideBvhNodes<kWidth>& nodes,
+                                std::span<const Ray> rays, HitRecord* best, bool* found,
+                                QueryScratch& scratch) {
+        using Node = WideBvhNode<kWidth>;
+        using Lane = PacketLane<NodeTest>;
+        const int n = static_cast<int>(rays.size());
+        for (int r = 0; r < n; ++r) found[r] = false;
+        if (nodes.empty()) return;
+        alignas(Lane) unsigned char storage[sizeof(Lane) * Tree::kPacketRays];
+        Lane* lanes = reinterpret_cast<Lane*>(storage);
+        std::uint32_t open = 0;
+        for (int r = 0; r < n; ++r) {
+            if (!is_valid(rays[r])) continue;
+            new (&lanes[r]) Lane(*bvh.set_, rays[r], scratch);
+            best[r] = HitRecord{};
+            best[r].t = rays[r].t_max;
+            open |= 1u << r;
+        }
+        TraversalCounters unused;
+
+        PacketEntry stack[(kWidth - 1) * kMaxDepth + 1];
+        PacketEntry* top = stack;
+        std::uint32_t first = 0, count = Node::kInterior, active = open;
+        for (;;) {
+            while (count == Node::kInterior && active != 0) {
+                const Node& node = nodes[first];
+                std::uint32_t child_rays[kWidth] = {};
+                float child_enter[kWidth];
+                std::fill_n(child_enter, kWidth, kFloatInfinity);
+                unsigned entered = 0;
+                for (std::uint32_t m = active; m != 0; m &= m - 1) {
+                    const int r = std::countr_zero(m);
+                    Lane& lane = lanes[r];
+                    alignas(32) float t_enter[kWidth];
+                    const unsigned mask =
+                        lane.box.signed_interval
+                            ? lane.test.template hit<true>(node, lane.t_max, t_enter)
+                            : lane.test.template hit<false>(node, lane.t_max, t_enter);
+                    for (unsigned c = mask; c != 0; c &= c - 1) {
+                        const int slot = std::countr_zero(c);
+                        child_enter[slot] = std::min(child_enter[slot], t_enter[slot]);
+                        child_rays[slot] |= 1u << r;
+                    }
+                    entered |= mask;
+                }
+                if (entered == 0) break;
+                PacketEntry* pushed = top;
+                for (unsigned c = entered; c != 0; c &= c - 1) {
+                    const int slot = std::countr_zero(c);
+                    *top++ = PacketEntry{node.first[slot], node.count[slot], child_rays[slot],
+                                         child_enter[slot]};
+                    prefetch(bvh, nodes, node.first[slot], node.count[slot]);
+                }
+                for (PacketEntry* i = pushed + 1; i != top; ++i) {
+                    const PacketEntry entry = *i;
+                    PacketEntry* j = i;
+                    for (; j != pushed && (j - 1)->t_enter < entry.t_enter; --j) *j = *(j - 1);
+                    *j = entry;
+                }
+                --top;
+                first = top->first;
+                count = top->count;
+                active = top->rays;
+            }
+            if (count != Node::kInterior && count != 0) {
+                for (std::uint32_t m = active; m != 0; m &= m - 1) {
+                    const int r = std::countr_zero(m);
+                    Lane& lane = lanes[r];
+                    if constexpr (kAny) {
+                        if (occluded_in_leaf<false>(bvh, lane.leaf, first, count, unused)) {
+                            found[r] = true;
+                            open &= ~(1u << r);
+                        }
+                    } else {
+                        found[r] |= nearest_in_leaf<false>(bvh, lane.leaf, first, count, best[r],
+                                                           lane.t_max, unused);
+                    }
+                }
+                if (open == 0) return;
+            }
+            // Each entry keeps the rays still open whose own entry may lie within their t_max
+            // (their least entry does not exceed it).
+            do {
+                if (top == stack) return;
+                --top;
+                active = top->rays & open;
+                for (std::uint32_t m = active; m != 0; m &= m - 1) {
+                    const int r = std::countr_zero(m);
+                    if (top->t_enter > lanes[r].t_max) active &= ~(1u << r);
+                }
+            } while (active == 0);
+            first = top->first;
+            count = top->count;
+        }
+    }
+
+#if CSGRT_BVH_AVX2
+    /// traverse_packet with the AVX2 node test, everything inlined and compiled for AVX2.
+    template <bool kAny>
+    [[gnu::target("avx2"), gnu::flatten]] static void traverse_packet_avx2(
+        const Tree& bvh, std::span<const Ray> rays, HitRecord* best, bool* found,
+        QueryScratch& scratch) {
+        traverse_packet<kAny, Avx2NodeTest>(bvh, bvh.nodes_8_, rays, best, found, scratch);
+    }
+#endif
+
+    /// Up to kPacketRays rays through the wide tree (width 4 or 8).
+    template <bool kAny>
+    static void packet(const Tree& bvh, std::span<const Ray> rays, HitRecord* best, bool* found,
+                       QueryScratch& scratch) {
+        if (bvh.config_.width == 8) {
+#if CSGRT_BVH_AVX2
+            if (bvh.use_avx2_) return traverse_packet_avx2<kAny>(bvh, rays, best, found, scratch);
+#endif
+            return traverse_packet<kAny, SseNodeTest<8>>(bvh, bvh.nodes_8_, rays, best, found,
+                                                         scratch);
+        }
+        traverse_packet<kAny, SseNodeTest<4>>(bvh, bvh.nodes_4_, rays, best, found, scratch);
     }
 };
 
@@ -883,6 +1085,61 @@ bool Bvh<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& s
         Traversal::all_hits(*this, ray, answer, scratch);
         return answer.size() > before;
     }
+}
+
+template <class Set>
+template <bool kAny>
+std::size_t Bvh<Set>::trace_packets(std::span<const Ray> rays, std::span<HitRecord> records,
+                                    std::span<bool> hit, QueryScratch& scratch) const {
+    std::size_t hits = 0;
+    // Instance paths of a ShapeSet's hits live in the scratch of one query at a time, and the
+    // binary tree has no packet traversal: those go one ray at a time.
+    if (std::is_same_v<Set, ShapeSet> || config_.width == 2 || set_ == nullptr) {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            if constexpr (kAny) {
+                hit[i] = occluded(rays[i], scratch);
+            } else {
+                hit[i] = intersect(rays[i], records[i], scratch);
+            }
+            hits += hit[i] ? 1 : 0;
+        }
+        return hits;
+    }
+    if constexpr (!std::is_same_v<Set, ShapeSet>) {
+        HitRecord best[kPacketRays];
+        bool found[kPacketRays];
+        for (std::size_t begin = 0; begin < rays.size(); begin += kPacketRays) {
+            const std::size_t n = std::min(kPacketRays, rays.size() - begin);
+            detail::BvhTraversal<Set>::template packet<kAny>(*this, rays.subspan(begin, n), best,
+                                                             found, scratch);
+            for (std::size_t r = 0; r < n; ++r) {
+                hit[begin + r] = found[r];
+                if constexpr (!kAny) {
+                    if (found[r]) records[begin + r] = best[r];
+                }
+                hits += found[r] ? 1 : 0;
+            }
+        }
+    }
+    return hits;
+}
+
+template <class Set>
+std::size_t Bvh<Set>::intersect_packets(std::span<const Ray> rays, std::span<HitRecord> records,
+                                        std::span<bool> hit, QueryScratch& scratch) const {
+    require(records.size() == rays.size(), "Bvh::intersect_packets", "records.size()",
+            "rays.size()", records.size());
+    require(hit.size() == rays.size(), "Bvh::intersect_packets", "hit.size()", "rays.size()",
+            hit.size());
+    return trace_packets<false>(rays, records, hit, scratch);
+}
+
+template <class Set>
+std::size_t Bvh<Set>::occluded_packets(std::span<const Ray> rays, std::span<bool> occluded,
+                                       QueryScratch& scratch) const {
+    require(occluded.size() == rays.size(), "Bvh::occluded_packets", "occluded.size()",
+            "rays.size()", occluded.size());
+    return trace_packets<true>(rays, {}, occluded, scratch);
 }
 
 template class Bvh<TriangleSet<float>>;

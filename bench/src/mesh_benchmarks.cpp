@@ -73,6 +73,10 @@ std::vector<Variant> mesh_variants(bool with_double, bool with_robust) {
         embree.kind = Variant::Kind::kEmbree;
         embree.name = "embree";
         variants.push_back(embree);
+        Variant packets = embree;
+        packets.name = "embree-packet";
+        packets.packets = true;
+        variants.push_back(packets);
         if (with_robust) {
             embree.name = "embree-robust";
             embree.robust = true;

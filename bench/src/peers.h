@@ -31,9 +31,12 @@ std::string embree_version();
 /// Embree 3 over the same triangles as `set` (its float corners, three vertices a triangle,
 /// unshared, as the set stores them), default build quality (medium), with
 /// RTC_SCENE_FLAG_ROBUST when `robust`; the device builds with `build_threads` threads.
-/// Queries are rtcIntersect1 and rtcOccluded1, one ray at a time like the other tracers.
+/// Queries are rtcIntersect1 and rtcOccluded1, one ray at a time like the other tracers, or
+/// with `packets` rtcIntersect8 and rtcOccluded8 on eight consecutive rays at a time (flagged
+/// coherent: Embree's packet path, for camera rays).
 /// Throws std::runtime_error when Embree is not available or reports an error.
 std::unique_ptr<Tracer> make_embree_tracer(const TriangleSet<float>& set, bool robust,
-                                           int build_threads, EmbreeBuild* build = nullptr);
+                                           int build_threads, EmbreeBuild* build = nullptr,
+                                           bool packets = false);
 
 }  // namespace csgrt::bench

@@ -216,7 +216,8 @@ const Tracer& MeshWorkload::tracer(const Variant& variant, VariantFacts* facts) 
             case Variant::Kind::kEmbree: {
                 EmbreeBuild build;
                 built->tracer = make_embree_tracer(float_set(), variant.robust,
-                                                   tbb::info::default_concurrency(), &build);
+                                                   tbb::info::default_concurrency(), &build,
+                                                   variant.packets);
                 built->facts.build_milliseconds = build.build_milliseconds;
                 built->facts.bytes_with_triangles = static_cast<double>(build.bytes);
                 built->facts.bytes = static_cast<double>(build.bytes - build.buffer_bytes);

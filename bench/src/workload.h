@@ -33,6 +33,8 @@ struct Variant {
     bool box_culling = false;
     /// Embree's RTC_SCENE_FLAG_ROBUST.
     bool robust = false;
+    /// Embree's packet queries (rtcIntersect8 / rtcOccluded8) instead of one ray at a time.
+    bool packets = false;
 
     /// Brute force is O(N) per ray, so it traces a bounded subset of each ray set.
     bool is_brute() const { return kind == Kind::kStructure && structure == "brute"; }

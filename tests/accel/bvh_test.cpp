@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -223,6 +224,123 @@ TYPED_TEST(BvhMeshTest, SameHitsAsBruteForceOnEveryMeshAndLayout) {
         }
     }
     EXPECT_GE(total_rays, test::scaled(100000));
+}
+
+/// A pinhole camera's rays: from a point outside the box through a width x width grid over the
+/// box's middle, row by row, as neighbouring pixels' rays (coherent, the packets' case).
+std::vector<Ray> camera_grid(const Aabb& box, int width) {
+    const Vector3 diagonal = box.diagonal();
+    const Point3 eye = box.center() + 1.5 * diagonal.norm() * Vector3(0.3, 0.25, 1.0).normalized();
+    std::vector<Ray> rays;
+    for (int y = 0; y < width; ++y) {
+        for (int x = 0; x < width; ++x) {
+            const Point3 target =
+                box.lower + Vector3((x + 0.5) / width * diagonal.x(),
+                                    (y + 0.5) / width * diagonal.y(), 0.5 * diagonal.z());
+            Ray ray;
+            ray.origin = eye;
+            ray.direction = target - eye;
+            rays.push_back(ray);
+        }
+    }
+    return rays;
+}
+
+TYPED_TEST(BvhMeshTest, PacketsGiveTheSingleRayAnswersBitForBit) {
+    // The packet traversal tests each ray against exactly the nodes and leaves its own
+    // traversal may need, in another order; the tie rule makes the nearest hit independent of
+    // the order, so intersect_packets must return intersect's very bits ray by ray, and both
+    // BruteForce's (the independent answer). Ray counts are not multiples of the packet size,
+    // and invalid rays sit among valid ones.
+    struct Case {
+        std::string name;
+        TestMesh mesh;
+    };
+    std::vector<Case> cases;
+    cases.push_back({"integer_cube(8)", test::integer_cube(8)});
+    cases.push_back({"sphere_mesh(5)", test::sphere_mesh(5)});
+    cases.push_back({"thin soup", thin_triangle_soup(4000, 7)});
+    cases.push_back({"teapot in stadium", teapot_in_stadium()});
+    const std::vector<std::pair<std::string, BvhConfig>> configs = {
+        {"default", BvhConfig{}},
+        {"width 8 SSE", BvhConfig{.avx2 = false}},
+        {"width 8 without blocks", BvhConfig{.triangle_blocks = false}},
+        {"width 4", BvhConfig{.width = 4}},
+        {"width 2", BvhConfig{.width = 2}}};
+    QueryScratch scratch;
+    for (const Case& c : cases) {
+        const TriangleSet<TypeParam> set(c.mesh.vertices, c.mesh.triangles);
+        BruteForce<TriangleSet<TypeParam>> brute;
+        brute.build(set, BruteForceConfig{.box_culling = true});
+        const Aabb box = c.name == "teapot in stadium"
+                             ? Aabb(Point3(-0.2, -0.2, -0.2), Point3(0.2, 0.2, 0.2))
+                             : mesh_box(c.mesh);
+        std::vector<Ray> rays = camera_grid(box, 45);
+        const std::vector<Ray> mixed = mixed_rays(box, test::scaled(3001), 77);
+        rays.insert(rays.end(), mixed.begin(), mixed.end());
+        for (std::size_t i = 5; i < rays.size(); i += 97) {
+            rays[i].direction = Vector3(std::numeric_limits<double>::quiet_NaN(), 0.0, 1.0);
+        }
+        std::vector<Answer> expected(rays.size());
+        int hits = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            HitRecord record;
+            expected[i] = Answer::of(brute.intersect(rays[i], record, scratch), record);
+            hits += expected[i].hit;
+        }
+        EXPECT_GT(hits, static_cast<int>(rays.size()) / 5) << c.name;
+        for (const auto& [name, config] : configs) {
+            Bvh<TriangleSet<TypeParam>> bvh;
+            bvh.build(set, config);
+            // A miss leaves its record as it was: fill them with a sentinel first.
+            HitRecord sentinel;
+            sentinel.t = -7.0;
+            sentinel.primitive = 12345;
+            std::vector<HitRecord> records(rays.size(), sentinel);
+            std::unique_ptr<bool[]> hit(new bool[rays.size()]);
+            std::unique_ptr<bool[]> occluded(new bool[rays.size()]);
+            const std::size_t count =
+                bvh.intersect_packets(rays, records, {hit.get(), rays.size()}, scratch);
+            const std::size_t occluded_count =
+                bvh.occluded_packets(rays, {occluded.get(), rays.size()}, scratch);
+            EXPECT_EQ(count, static_cast<std::size_t>(hits)) << c.name << " " << name;
+            EXPECT_EQ(occluded_count, static_cast<std::size_t>(hits)) << c.name << " " << name;
+            int failures = 0;
+            for (std::size_t i = 0; i < rays.size() && failures < 10; ++i) {
+                HitRecord single_record;
+                const Answer single =
+                    Answer::of(bvh.intersect(rays[i], single_record, scratch), single_record);
+                const Answer packet = Answer::of(hit[i], records[i]);
+                const bool left = hit[i] || (records[i].t == -7.0 && records[i].primitive == 12345);
+                if (packet != single || packet != expected[i] || occluded[i] != expected[i].hit ||
+                    !left) {
+                    ++failures;
+                    ADD_FAILURE() << c.name << " " << name << " ray " << i << ": "
+                                  << describe(rays[i]) << "\n  brute force: " << expected[i]
+                                  << "\n  single ray:  " << single << "\n  packet:      "
+                                  << packet << "\n  occluded " << occluded[i];
+                }
+            }
+        }
+    }
+}
+
+TEST(Bvh, PacketSpansOfDifferentSizesThrow) {
+    const TestMesh mesh = test::sphere_mesh(2);
+    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
+    Bvh<TriangleSet<float>> bvh;
+    bvh.build(set);
+    QueryScratch scratch;
+    const std::vector<Ray> rays(3);
+    std::vector<HitRecord> records(2);
+    bool hit[3], occluded[2];
+    EXPECT_THROW(bvh.intersect_packets(rays, records, hit, scratch), InvalidParameter);
+    records.resize(3);
+    EXPECT_THROW(bvh.intersect_packets(rays, records, {hit, 2}, scratch), InvalidParameter);
+    EXPECT_THROW(bvh.occluded_packets(rays, occluded, scratch), InvalidParameter);
+    // An unbuilt tree answers every ray with a miss, as intersect does.
+    const Bvh<TriangleSet<float>> unbuilt;
+    EXPECT_EQ(unbuilt.intersect_packets(rays, records, hit, scratch), 0u);
 }
 
 TYPED_TEST(BvhMeshTest, AllHitsEqualBruteForceAsASet) {

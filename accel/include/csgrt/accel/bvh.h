@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
@@ -50,6 +51,21 @@ public:
     bool query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
                TraversalCounters& counters) const;
 
+    /// Rays that intersect_packets and occluded_packets take through the tree together.
+    static constexpr std::size_t kPacketRays = 8;
+    /// The nearest hits of many rays, traced kPacketRays at a time through the tree together:
+    /// each node is fetched once for the rays that enter it, which pays for coherent rays
+    /// (camera rays of neighbouring pixels). hit[i] and, where it is true, records[i] are what
+    /// intersect(rays[i], records[i], scratch) gives, bit for bit; records[i] of a miss is left
+    /// as it was. Returns the number of hits. Width 2 and ShapeSet trees take one ray at a time.
+    /// Throws InvalidParameter when the spans' sizes differ.
+    std::size_t intersect_packets(std::span<const Ray> rays, std::span<HitRecord> records,
+                                  std::span<bool> hit, QueryScratch& scratch) const;
+    /// occluded(rays[i], scratch) into occluded[i], kPacketRays rays at a time as
+    /// intersect_packets; returns the number of occluded rays.
+    std::size_t occluded_packets(std::span<const Ray> rays, std::span<bool> occluded,
+                                 QueryScratch& scratch) const;
+
     /// The binary nodes (width 2), the 4- or 8-wide nodes (width 4 or 8; each empty for the
     /// other widths), and the leaves' contents: primitive indices in leaf order, or triangle
     /// blocks (TriangleSet<float> with triangle_blocks; the indices are then empty). A leaf
@@ -73,6 +89,10 @@ public:
 private:
     friend struct detail::BvhTraversal<Set>;
     using AcceleratorBase<Bvh<Set>, Set>::stats_;
+
+    template <bool kAny>
+    std::size_t trace_packets(std::span<const Ray> rays, std::span<HitRecord> records,
+                              std::span<bool> hit, QueryScratch& scratch) const;
 
     /// Copies the triangles of each leaf of `tree` into blocks_, in leaf order, and points
     /// the leaves at their first block (TriangleSet<float> only).
