@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "csgrt/accel/cgal_reference.h"
+#include "csgrt/reference/cgal_reference.h"
 #include "csgrt/accel/factory.h"
 #include "csgrt/accel/triangle_set.h"
 #include "support/meshes.h"
