@@ -1097,9 +1097,9 @@ std::size_t Bvh<Set>::trace_packets(std::span<const Ray> rays, std::span<HitReco
     if (std::is_same_v<Set, ShapeSet> || config_.width == 2 || set_ == nullptr) {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             if constexpr (kAny) {
-                hit[i] = occluded(rays[i], scratch);
+                hit[i] = this->occluded(rays[i], scratch);
             } else {
-                hit[i] = intersect(rays[i], records[i], scratch);
+                hit[i] = this->intersect(rays[i], records[i], scratch);
             }
             hits += hit[i] ? 1 : 0;
         }

@@ -255,7 +255,7 @@ TEST_F(CommandLine, AnOutputThatIsTheSceneIsRefusedInEverySpelling) {
     fs::create_symlink(scene, directory_ / "link.exr");
     for (const fs::path& output : {scene, other_spelling, directory_ / "link.exr"}) {
         const ProgramRun result = run({"render", scene.string(), "-o", output.string()});
-        expect_one_line_error(result, "is the scene file");
+        expect_one_line_error(result, "is the scene file", 2);  // a usage error
     }
     std::ifstream in(scene);
     const std::string kept{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -275,7 +275,7 @@ TEST_F(CommandLine, AnUnwritableOutputFolderIsRefusedBeforeRendering) {
     }
     const ProgramRun result = run({"render", scene_, "-o", (folder / "out.exr").string()});
     fs::permissions(folder, fs::perms::owner_all);
-    expect_one_line_error(result, "' is not writable: Permission denied");
+    expect_one_line_error(result, "' is not writable: Permission denied", 2);  // a usage error
 }
 
 TEST_F(CommandLine, AnImageLargerThanMemoryIsRefusedWithTheEstimate) {
@@ -285,7 +285,7 @@ TEST_F(CommandLine, AnImageLargerThanMemoryIsRefusedWithTheEstimate) {
     std::ostringstream out, err;
     CommandLineStreams streams{out, err};
     streams.memory_bytes = 1u << 20;
-    EXPECT_EQ(run_csgrt(5, argv, streams), 1);
+    EXPECT_EQ(run_csgrt(5, argv, streams), 2);  // a usage error: the size asked for
     EXPECT_NE(
         err.str().find("a 640x480 image needs about 17 MiB, more than the 1 MiB of memory free"),
         std::string::npos)
