@@ -222,9 +222,10 @@ TEST(MaterialKeys, TheSceneFileReadsAndChecksThem) {
     EXPECT_EQ(m.mirror, Vector3::Constant(0.5));
     EXPECT_EQ(m.ior, 1.5);
     // Defaults: none of the secondary terms.
-    const Material& plain =
-        load_scene_from_string(R"({"objects": [], "materials": {"p": {}}})", "p.json")
-            .materials()[1];
+    // The scene is kept: a reference into a temporary's materials would dangle (ASan).
+    const Scene plain_scene =
+        load_scene_from_string(R"({"objects": [], "materials": {"p": {}}})", "p.json");
+    const Material& plain = plain_scene.materials()[1];
     EXPECT_EQ(plain.mirror, Vector3::Zero());
     EXPECT_EQ(plain.ior, 0.0);
     // Each bad value is an error naming the file, the place and what was expected.
