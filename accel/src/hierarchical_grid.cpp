@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "accelerator_base.h"
+#include "split_query.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
@@ -312,15 +313,7 @@ template <class Set>
 template <QueryKind kKind, bool kCounted>
 bool HierarchicalGrid<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
                                   TraversalCounters& counters) const {
-    if constexpr (kKind == QueryKind::kNearest) {
-        return intersect_impl<kCounted>(ray, answer, scratch, counters);
-    } else if constexpr (kKind == QueryKind::kAny) {
-        return occluded_impl<kCounted>(ray, scratch, counters);
-    } else {
-        const std::size_t before = answer.size();
-        all_hits_impl(ray, answer, scratch);
-        return answer.size() > before;
-    }
+    return detail::SplitQuery::query<kKind, kCounted>(*this, ray, answer, scratch, counters);
 }
 
 template <class Set>

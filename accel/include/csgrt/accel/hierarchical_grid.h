@@ -10,6 +10,10 @@
 
 namespace csgrt {
 
+namespace detail {
+struct SplitQuery;  // accel/src/split_query.h: the dispatch to the three walks below
+}  // namespace detail
+
 /// A hierarchy of uniform grids after Jevans & Wyvill, "Adaptive Voxel Subdivision for Ray
 /// Tracing", Graphics Interface 1989: a coarse top grid (N^0.6 cells, Ize et al. 2007) whose
 /// crowded cells hold grids of their own, recursively. Unlike Klimaszewski & Sederberg, "Faster
@@ -67,6 +71,7 @@ private:
     template <class Visitor>
     bool traverse(std::uint32_t grid, const Ray& ray, const Vector3& inverse_direction,
                   Visitor& visitor) const;
+    friend struct detail::SplitQuery;
     template <bool kCount>
     bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
                         TraversalCounters& counters) const;

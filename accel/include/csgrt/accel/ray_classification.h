@@ -20,6 +20,8 @@ namespace csgrt {
 
 namespace detail {
 
+struct SplitQuery;  // accel/src/split_query.h: the dispatch to the three walks below
+
 /// The face of the direction cube a direction points through, and its coordinates on it: the
 /// dominant axis a = argmax |d_i| (ties go to the lower axis), the sign of d_a, and
 /// u = d_b / |d_a|, v = d_c / |d_a| in [-1, 1], with b = a+1, c = a+2 (mod 3).
@@ -188,6 +190,7 @@ private:
     int split_axis(int face, int depth, const double lower[5], const double upper[5]) const;
     void root_cell(double lower[5], double upper[5]) const;
     bool is_final(const Node& node, int depth) const;
+    friend struct detail::SplitQuery;
     template <bool kCount>
     bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
                         TraversalCounters& counters) const;

@@ -13,6 +13,8 @@ namespace csgrt {
 
 namespace detail {
 
+struct SplitQuery;  // accel/src/split_query.h: the dispatch to the three walks below
+
 /// The cells of one uniform grid: a box cut into resolution[0] x resolution[1] x resolution[2]
 /// equal cells, numbered x fastest. Cell (i, j, k) spans lower + (i, j, k) * cell_size to
 /// lower + (i + 1, j + 1, k + 1) * cell_size; the traversal and the build use these same
@@ -86,6 +88,7 @@ public:
     std::span<const std::uint32_t> unbounded_primitives() const { return unbounded_; }
 
 private:
+    friend struct detail::SplitQuery;
     template <bool kCount>
     bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
                         TraversalCounters& counters) const;
