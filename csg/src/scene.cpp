@@ -29,6 +29,7 @@ std::uint32_t Scene::add_object(std::shared_ptr<const Shape> shape, std::uint32_
             objects_.size());
     objects_.push_back(SceneObject{std::move(shape), material, std::move(name)});
     committed_ = false;
+    hittable_ = false;
     group_.reset();
     return static_cast<std::uint32_t>(objects_.size() - 1);
 }
@@ -43,6 +44,7 @@ void Scene::set_camera(Camera camera) {
 
 void Scene::commit(const SceneConfig& config) {
     committed_ = false;
+    hittable_ = false;
     group_.reset();
     camera_.validate();
     std::vector<std::shared_ptr<const Shape>> shapes;
@@ -57,13 +59,14 @@ void Scene::commit(const SceneConfig& config) {
                   " unbounded object(s) tested on every ray";
     }
     bounds_ = group->bounded_bounds();
+    hittable_ = group->bounded().size() > 0 || !group->unbounded().empty();
     group_ = std::move(group);
     accelerator_reason_ = std::move(reason);
     committed_ = true;
 }
 
 std::optional<Hit> Scene::intersect(const Ray& ray, QueryScratch& scratch) const {
-    if (!committed_ || !is_valid(ray)) return std::nullopt;
+    if (!hittable_ || !is_valid(ray)) return std::nullopt;
     scratch.reset();
     HitRecord record;
     if (!group_->nearest(ray, record, scratch)) return std::nullopt;
@@ -72,7 +75,7 @@ std::optional<Hit> Scene::intersect(const Ray& ray, QueryScratch& scratch) const
 
 std::optional<Hit> Scene::intersect_counted(const Ray& ray, QueryScratch& scratch,
                                             TraversalCounters& counters) const {
-    if (!committed_ || !is_valid(ray)) return std::nullopt;
+    if (!hittable_ || !is_valid(ray)) return std::nullopt;
     scratch.reset();
     HitRecord record;
     if (!group_->nearest_counted(ray, record, scratch, counters)) return std::nullopt;
@@ -80,7 +83,7 @@ std::optional<Hit> Scene::intersect_counted(const Ray& ray, QueryScratch& scratc
 }
 
 bool Scene::occluded(const Ray& ray, QueryScratch& scratch) const {
-    if (!committed_ || !is_valid(ray)) return false;
+    if (!hittable_ || !is_valid(ray)) return false;
     scratch.reset();
     return group_->any(ray, scratch);
 }

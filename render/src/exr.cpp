@@ -14,6 +14,7 @@
 #include <OpenEXR/ImfPartType.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfThreading.h>
 #include <OpenEXR/ImfVecAttribute.h>
 #include <unistd.h>
 
@@ -24,6 +25,7 @@
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <thread>
 #include <vector>
 
 #include "csgrt/csg/scene.h"
@@ -199,6 +201,17 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
                                                          sizeof(Pixel), row));
         }
     }
+    // OpenEXR zips its 16-line chunks on its own thread pool when it has one; without, a 2048^2
+    // frame's zlib work runs on one core. The chunks are independent and written in line order,
+    // so the file's bytes do not depend on the thread count. Set once for the process, and only
+    // if the program has not chosen a count itself.
+    static const bool kThreadsChosen = [] {
+        if (Imf::globalThreadCount() == 0) {
+            Imf::setGlobalThreadCount(static_cast<int>(std::thread::hardware_concurrency()));
+        }
+        return true;
+    }();
+    static_cast<void>(kThreadsChosen);
     Imf::MultiPartOutputFile file(path.c_str(), headers.data(), static_cast<int>(headers.size()));
     for (std::size_t part = 0; part < headers.size(); ++part) {
         Imf::OutputPart output(file, static_cast<int>(part));

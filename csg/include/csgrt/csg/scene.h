@@ -123,6 +123,9 @@ private:
     Camera camera_;
     Aabb bounds_;
     bool committed_ = false;
+    /// Whether the committed scene has any object a ray could hit: without one every query
+    /// answers at once, so an empty frame costs only its camera rays (issue 13's fixed cost).
+    bool hittable_ = false;
     std::string accelerator_reason_;
     /// Held by shared_ptr so a Scene stays cheap to copy (copies share the built structure).
     std::shared_ptr<const ShapeGroup> group_;
