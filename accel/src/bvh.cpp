@@ -127,6 +127,8 @@ struct BoxRay {
     /// the near one, and the products below never form 0 * inf except in a face's plane.
     bool negative[3];
     bool signed_interval;
+    /// is_valid(ray), found from the representability test where it can be (see below).
+    bool valid;
     float t_min;
 
     // Inlined into the query: it runs once a ray, and most camera rays never reach a leaf.
@@ -160,6 +162,13 @@ struct BoxRay {
         const bool representable = _mm_movemask_pd(ok) == 3;
         const int signs = _mm_movemask_pd(v1) >> 1 | _mm_movemask_pd(v2) << 1;
         for (int axis = 0; axis < 3; ++axis) negative[axis] = (signs >> axis) & 1;
+        // A representable ray has a finite origin and direction, and a non-zero direction
+        // component is at least 2^-100, so its squared norm (>= 2^-200) is positive exactly
+        // when some component is not zero; t_min <= t_max is false for NaN. So is_valid
+        // reduces to two tests, and only the rare unrepresentable ray pays for the full one.
+        const int zero_direction = _mm_movemask_pd(_mm_cmpeq_pd(v1, zero)) >> 1 |
+                                   _mm_movemask_pd(_mm_cmpeq_pd(v2, zero)) << 1;
+        valid = representable ? zero_direction != 7 && ray.t_min <= ray.t_max : is_valid(ray);
 #else
         bool representable = true;
         for (int axis = 0; axis < 3; ++axis) {
@@ -169,6 +178,7 @@ struct BoxRay {
                                             (magnitude >= 1.0 / kLargestBoxRayValue)));
             negative[axis] = std::signbit(d);
         }
+        valid = is_valid(ray);
 #endif
         if (!representable) [[unlikely]] {
             // Every slab distance becomes NaN, which the tests ignore: every box is entered.
@@ -413,8 +423,8 @@ struct BvhTraversal {
     /// binary_nodes) and the float upper bound of the interval, which it may lower; it
     /// returns true to stop.
     template <bool kCount, class Leaf>
-    static void traverse(const Tree& bvh, const Ray& ray, TraversalCounters& counters, Leaf& leaf) {
-        const BoxRay box_ray(ray);
+    static void traverse(const Tree& bvh, const Ray& ray, const BoxRay& box_ray,
+                         TraversalCounters& counters, Leaf& leaf) {
         if (bvh.config_.width == 8) {
 #if CSGRT_BVH_AVX2
             if (bvh.use_avx2_)
@@ -712,7 +722,9 @@ struct BvhTraversal {
     template <bool kCount>
     static bool intersect(const Tree& bvh, const Ray& ray, HitRecord& record, QueryScratch& scratch,
                           TraversalCounters& counters) {
-        if (bvh.set_ == nullptr || !is_valid(ray)) return false;
+        if (bvh.set_ == nullptr) return false;
+        const BoxRay box_ray(ray);
+        if (!box_ray.valid) return false;
         // The leaf ray is made at the first leaf: most camera rays reach none (they miss the
         // mesh's boxes), and for them the set's prepare and the block ray are pure cost.
         std::optional<LeafRay> leaf_ray;
@@ -725,7 +737,7 @@ struct BvhTraversal {
             found |= nearest_in_leaf<kCount>(bvh, *leaf_ray, first, count, best, t_max, counters);
             return false;
         };
-        traverse<kCount>(bvh, ray, counters, leaf);
+        traverse<kCount>(bvh, ray, box_ray, counters, leaf);
         if (found) record = best;
         return found;
     }
@@ -733,7 +745,9 @@ struct BvhTraversal {
     template <bool kCount>
     static bool occluded(const Tree& bvh, const Ray& ray, QueryScratch& scratch,
                          TraversalCounters& counters) {
-        if (bvh.set_ == nullptr || !is_valid(ray)) return false;
+        if (bvh.set_ == nullptr) return false;
+        const BoxRay box_ray(ray);
+        if (!box_ray.valid) return false;
         // Made up front, unlike intersect's: shadow rays start on a surface and nearly all
         // reach a leaf, and the deferred form cost them 58 instructions a ray (callgrind).
         const LeafRay leaf_ray(*bvh.set_, ray, scratch);
@@ -741,13 +755,15 @@ struct BvhTraversal {
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
             return occluded = occluded_in_leaf<kCount>(bvh, leaf_ray, first, count, counters);
         };
-        traverse<kCount>(bvh, ray, counters, leaf);
+        traverse<kCount>(bvh, ray, box_ray, counters, leaf);
         return occluded;
     }
 
     static void all_hits(const Tree& bvh, const Ray& ray, std::vector<HitRecord>& hits,
                          QueryScratch& scratch) {
-        if (bvh.set_ == nullptr || !is_valid(ray)) return;
+        if (bvh.set_ == nullptr) return;
+        const BoxRay box_ray(ray);
+        if (!box_ray.valid) return;
         const LeafRay leaf_ray(*bvh.set_, ray, scratch);
         TraversalCounters unused;
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
@@ -760,7 +776,7 @@ struct BvhTraversal {
                                            return false;
                                        });
         };
-        traverse<false>(bvh, ray, unused, leaf);
+        traverse<false>(bvh, ray, box_ray, unused, leaf);
     }
 
     /// One ray of a packet: its node test, its leaf ray and the float upper bound of its
