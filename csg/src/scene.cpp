@@ -3,6 +3,8 @@
 #include <string>
 #include <utility>
 
+#include <Eigen/Geometry>
+
 #include "csgrt/core/error.h"
 #include "csgrt/csg/shape_group.h"
 
@@ -34,12 +36,50 @@ std::uint32_t Scene::add_object(std::shared_ptr<const Shape> shape, std::uint32_
     return static_cast<std::uint32_t>(objects_.size() - 1);
 }
 
+namespace {
+
+void require_area_light(const Vector3& radiance, int samples, std::string_view what) {
+    require(radiance.allFinite() && (radiance.array() >= 0.0).all(), what, "radiance",
+            "finite and >= 0", radiance);
+    require(samples >= 1 && samples <= kMaxAreaLightSamples, what, "samples",
+            "in [1, " + std::to_string(kMaxAreaLightSamples) + "]", samples);
+}
+
+}  // namespace
+
 void Scene::add_light(Light light) {
+    if (const auto* rectangle = std::get_if<RectangleLight>(&light)) {
+        require_area_light(rectangle->radiance, rectangle->samples, "RectangleLight");
+        const Vector3 normal = rectangle->edge_u.cross(rectangle->edge_v);
+        require(rectangle->corner.allFinite() && normal.allFinite() && normal.norm() > 0.0,
+                "RectangleLight", "edges", "finite and not parallel", normal);
+    } else if (const auto* disk = std::get_if<DiskLight>(&light)) {
+        require_area_light(disk->radiance, disk->samples, "DiskLight");
+        require_positive(disk->radius, "DiskLight", "radius");
+        require(disk->centre.allFinite() && disk->normal.allFinite() && disk->normal.norm() > 0.0,
+                "DiskLight", "normal", "finite and non-zero", disk->normal);
+    } else if (const auto* sphere = std::get_if<SphereLight>(&light)) {
+        require_area_light(sphere->radiance, sphere->samples, "SphereLight");
+        require_positive(sphere->radius, "SphereLight", "radius");
+        require_finite(sphere->centre, "SphereLight", "centre");
+    }
     lights_.push_back(std::move(light));
 }
 
 void Scene::set_camera(Camera camera) {
     camera_ = std::move(camera);
+}
+
+void Scene::set_ambient(const Vector3& ambient) {
+    require(ambient.allFinite() && (ambient.array() >= 0.0).all(), "Scene", "ambient",
+            "finite and >= 0", ambient);
+    ambient_ = ambient;
+}
+
+void Scene::set_background(const Vector3& background) {
+    require(background.allFinite() && (background.array() >= 0.0).all(), "Scene", "background",
+            "finite and >= 0", background);
+    background_ = background;
 }
 
 void Scene::commit(const SceneConfig& config) {

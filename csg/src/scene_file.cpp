@@ -353,6 +353,7 @@ private:
     void camera(Scene& scene);
     void materials(Scene& scene, std::map<std::string, std::uint32_t>& by_name);
     void lights(Scene& scene);
+    void ambient_and_background(Scene& scene);
 
     /// Counts `shape`'s expanded leaves into the scene's total and fails at `pointer` once the
     /// total passes kMaxExpandedLeaves.
@@ -1092,10 +1093,80 @@ void Loader::lights(Scene& scene) {
             light.radiance = fields.colour("radiance", light.radiance);
             check_colour("radiance", light.radiance);
             scene.add_light(light);
+        } else if (type == "rectangle" || type == "disk" || type == "sphere") {
+            // Area lights (render/lights.h): a radiance and a count of stratified samples.
+            fields.set_what("a " + type + " light");
+            const Vector3 radiance = fields.colour("radiance", Vector3::Constant(10.0));
+            check_colour("radiance", radiance);
+            int samples = kDefaultAreaLightSamples;
+            if (fields.has("samples")) {
+                const std::size_t count = fields.count("samples");
+                if (count < 1 || count > static_cast<std::size_t>(kMaxAreaLightSamples)) {
+                    fields.fail("samples", "expected a sample count in [1, " +
+                                               std::to_string(kMaxAreaLightSamples) + "], got " +
+                                               std::to_string(count));
+                }
+                samples = static_cast<int>(count);
+            }
+            auto positive_radius = [&] {
+                const double radius = fields.number("radius", 1.0);
+                if (!(radius > 0.0 && radius <= kMaxLength)) {
+                    fields.fail("radius", "expected a radius in (0, 1e150], got " +
+                                              detail::describe(radius));
+                }
+                return radius;
+            };
+            if (type == "rectangle") {
+                RectangleLight light{.radiance = radiance, .samples = samples};
+                light.corner = fields.vector("corner");
+                require_length(light.corner, fields, "corner", "the corner", false);
+                for (const char* key : {"edge_u", "edge_v"}) {
+                    Vector3& edge = key[5] == 'u' ? light.edge_u : light.edge_v;
+                    edge = fields.vector(key);
+                    require_length(edge, fields, key, "the edge", true);
+                }
+                const Vector3 normal = light.edge_u.cross(light.edge_v);
+                if (!(normal.norm() > 1e-12 * light.edge_u.norm() * light.edge_v.norm())) {
+                    fields.fail("edge_v", "expected an edge not parallel to edge_u, got " +
+                                              detail::describe(light.edge_v));
+                }
+                scene.add_light(light);
+            } else if (type == "disk") {
+                DiskLight light{.radiance = radiance, .samples = samples};
+                light.centre = fields.vector("center");
+                require_length(light.centre, fields, "center", "the center", false);
+                light.normal = fields.vector("normal");
+                require_length(light.normal, fields, "normal", "the normal", true);
+                light.radius = positive_radius();
+                scene.add_light(light);
+            } else {
+                SphereLight light{.radiance = radiance, .samples = samples};
+                light.centre = fields.vector("center");
+                require_length(light.centre, fields, "center", "the center", false);
+                light.radius = positive_radius();
+                scene.add_light(light);
+            }
         } else {
-            fields.fail("type", "expected \"point\" or \"directional\", got " + quote_name(type));
+            fields.fail("type", "expected \"point\" or \"directional\", or an area light "
+                                "\"rectangle\", \"disk\" or \"sphere\", got " + quote_name(type));
         }
         fields.finish();
+    }
+}
+
+/// The top-level "ambient" and "background" colours (docs/scene-format.md): linear radiance,
+/// each channel in [0, kMaxIntensity].
+void Loader::ambient_and_background(Scene& scene) {
+    Fields fields(root_, "", source_, "the scene");
+    for (const char* key : {"ambient", "background"}) {
+        if (!root_.contains(key)) continue;
+        const Vector3 colour = fields.colour(key, Vector3::Zero());
+        if (!((colour.array() >= 0.0) && (colour.array() <= kMaxIntensity)).all()) {
+            fields.fail(key, "expected values in [0, " + detail::describe(kMaxIntensity) +
+                                 "] (linear radiance), got " + detail::describe(colour));
+        }
+        if (key[0] == 'a') scene.set_ambient(colour);
+        else scene.set_background(colour);
     }
 }
 
@@ -1103,13 +1174,15 @@ Scene Loader::load() {
     Fields top(root_, "", source_, "the scene");
     Scene scene;
     // Asked for so finish() accepts them; each is read below.
-    for (const char* key : {"description", "camera", "materials", "lights", "definitions"})
+    for (const char* key : {"description", "camera", "materials", "lights", "definitions",
+                            "ambient", "background"})
         top.has(key);
     if (top.has("description")) top.string("description");
     camera(scene);
     std::map<std::string, std::uint32_t> material_index;
     materials(scene, material_index);
     lights(scene);
+    ambient_and_background(scene);
     if (top.has("definitions")) {
         definitions_ = &root_.at("definitions");
         if (!definitions_->is_object()) {

@@ -15,6 +15,7 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/csg/scene.h"
+#include "csgrt/render/lights.h"
 #include "csgrt/render/materials.h"
 #include "csgrt/render/sampling.h"
 #include "csgrt/render/shadow_offset.h"
@@ -55,6 +56,16 @@ const Material& material_of(const Scene& scene, std::uint32_t object_id) {
     return scene.materials()[material];
 }
 
+/// The scene's ambient radiance plus RenderSettings::ambient (docs/rendering.md: the two add).
+Vector3 ambient_of(const Frame& frame) {
+    return frame.scene.ambient() + frame.settings.ambient;
+}
+
+/// The radiance of rays that hit nothing: the scene's background plus RenderSettings::background.
+Vector3 background_of(const Frame& frame) {
+    return frame.scene.background() + frame.settings.background;
+}
+
 /// Linear radiance leaving `hit` toward the camera along `ray` (unit direction).
 Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
               RayTally& tally) {
@@ -69,49 +80,68 @@ Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& 
 
     if (frame.scene.lights().empty()) {
         // An eye light: without it a scene without lights would render black.
-        return albedo * std::abs(shading.dot(view)) + albedo.cwiseProduct(frame.settings.ambient);
+        return albedo * std::abs(shading.dot(view)) + albedo.cwiseProduct(ambient_of(frame));
     }
 
     // Sized by the precision of the surface hit, not by the scene's distance from the origin.
     const Point3 origin = spawn_ray_origin(hit, geometric);
-    Vector3 radiance = albedo.cwiseProduct(frame.settings.ambient);
-    for (const Light& light : frame.scene.lights()) {
-        Vector3 to_light;
-        Vector3 irradiance;
-        Ray shadow;
-        shadow.origin = origin;
-        if (const auto* point = std::get_if<PointLight>(&light)) {
-            const Vector3 offset = point->position - hit.point;
-            const double distance_squared = offset.squaredNorm();
-            if (!(distance_squared > 0.0)) continue;
-            to_light = offset / std::sqrt(distance_squared);
-            irradiance =
-                point->falloff == 2.0
-                    ? Vector3(point->intensity / distance_squared)
-                    : Vector3(point->intensity / std::pow(distance_squared, 0.5 * point->falloff));
-            // Up to the light, stopping short of it by the same relative margin the origin
-            // keeps from the surface, so a light lying on a surface is not hidden by it.
-            shadow.direction = point->position - origin;
-            shadow.t_max = 1.0 - kRayOffsetRelative;
-        } else {
-            const auto& directional = std::get<DirectionalLight>(light);
-            to_light = -directional.direction.normalized();
-            irradiance = directional.radiance;
-            shadow.direction = to_light;
-            shadow.t_max = kInfinity;
-        }
-        const double cosine = shading.dot(to_light);
-        // A light behind the surface (by either normal) sends nothing and needs no shadow ray.
-        if (!(cosine > 0.0) || !(geometric.dot(to_light) > 0.0)) continue;
-        ++tally.shadow_rays;
-        if (frame.scene.occluded(shadow, scratch)) {
-            ++tally.shadow_rays_blocked;
-            continue;
-        }
-        radiance += albedo.cwiseProduct(irradiance) * (cosine / kPi);
-        if (material.specular.maxCoeff() > 0.0) {
-            const double lobe = phong_lobe(to_light, view, shading, material.shininess);
-            radiance += material.specular.cwiseProduct(irradiance) * (lobe * cosine);
+    Vector3 radiance = albedo.cwiseProduct(ambient_of(frame));
+    const std::vector<Light>& lights = frame.scene.lights();
+    for (std::size_t index = 0; index < lights.size(); ++index) {
+        const Light& light = lights[index];
+        const int samples = light_sample_count(light);
+        // Area lights: `samples` shadow rays, one per stratum of the light's area, jittered by
+        // a stream that depends only on the point shaded (render/lights.h), so renders are
+        // reproducible whatever the threads do.
+        const StrataGrid strata = samples > 1 ? strata_for(samples) : StrataGrid{};
+        SampleRandom random(samples > 1 ? light_sample_seed(hit.point, frame.settings.seed, index)
+                                        : 0);
+        for (int sample = 0; sample < samples; ++sample) {
+            Vector3 to_light;
+            Vector3 irradiance;
+            Ray shadow;
+            shadow.origin = origin;
+            if (const auto* point = std::get_if<PointLight>(&light)) {
+                const Vector3 offset = point->position - hit.point;
+                const double distance_squared = offset.squaredNorm();
+                if (!(distance_squared > 0.0)) continue;
+                to_light = offset / std::sqrt(distance_squared);
+                irradiance = point->falloff == 2.0
+                                 ? Vector3(point->intensity / distance_squared)
+                                 : Vector3(point->intensity /
+                                           std::pow(distance_squared, 0.5 * point->falloff));
+                // Up to the light, stopping short of it by the same relative margin the origin
+                // keeps from the surface, so a light lying on a surface is not hidden by it.
+                shadow.direction = point->position - origin;
+                shadow.t_max = 1.0 - kRayOffsetRelative;
+            } else if (const auto* directional = std::get_if<DirectionalLight>(&light)) {
+                to_light = -directional->direction.normalized();
+                irradiance = directional->radiance;
+                shadow.direction = to_light;
+                shadow.t_max = kInfinity;
+            } else {
+                const std::optional<LightSample> on_light =
+                    sample_light(light, hit.point, stratified_sample(strata, sample, random));
+                if (!on_light) continue;
+                to_light = on_light->to_light;
+                irradiance = on_light->irradiance;
+                shadow.direction = *on_light->position - origin;
+                shadow.t_max = 1.0 - kRayOffsetRelative;
+            }
+            const double cosine = shading.dot(to_light);
+            // A light behind the surface (by either normal) sends nothing and needs no shadow
+            // ray.
+            if (!(cosine > 0.0) || !(geometric.dot(to_light) > 0.0)) continue;
+            ++tally.shadow_rays;
+            if (frame.scene.occluded(shadow, scratch)) {
+                ++tally.shadow_rays_blocked;
+                continue;
+            }
+            radiance += albedo.cwiseProduct(irradiance) * (cosine / kPi);
+            if (material.specular.maxCoeff() > 0.0) {
+                const double lobe = phong_lobe(to_light, view, shading, material.shininess);
+                radiance += material.specular.cwiseProduct(irradiance) * (lobe * cosine);
+            }
         }
     }
     return radiance;
@@ -126,7 +156,7 @@ Vector3 trace(const Frame& frame, const Ray& ray, QueryScratch& scratch, RayTall
     if (depth > frame.settings.max_depth) return Vector3::Zero();
     ++tally.secondary_rays;
     const std::optional<Hit> hit = frame.scene.intersect(ray, scratch);
-    if (!hit) return frame.settings.background;
+    if (!hit) return background_of(frame);
     return shade_surface(frame, ray, *hit, scratch, tally, depth);
 }
 
@@ -214,7 +244,7 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
             colour = shade_surface(frame, centre, *centre_hit, scratch, tally, 0);
             covered = 1;
         } else {
-            colour = settings.background;
+            colour = background_of(frame);
         }
     } else {
         SampleRandom random = pixel_random(settings.seed, x, y);
@@ -223,7 +253,7 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
             const Ray ray = frame.film.ray((x + film.x()) / width, (y + film.y()) / height);
             const std::optional<Hit> hit = frame.scene.intersect(ray, scratch);
             if (!hit) {
-                colour += settings.background;
+                colour += background_of(frame);
                 continue;
             }
             tally.count_hit(hit->object_id);

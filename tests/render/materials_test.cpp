@@ -175,6 +175,47 @@ TEST(Ambient, AddsAlbedoTimesAmbientUnshadowed) {
     EXPECT_THROW(render(scene, settings), InvalidParameter);
 }
 
+TEST(Ambient, SceneAmbientAndBackgroundComeFromTheFileAndAddToTheSettings) {
+    // A grey ball (albedo 0.5) lit only from behind, seen head on: its centre pixel is
+    // albedo * (scene ambient + settings ambient); a camera aimed beside it sees
+    // scene background + settings background. Pixels are floats: 1e-7 covers their rounding.
+    const std::string text = R"({
+        "ambient": [0.2, 0.4, 0.0],
+        "background": [0.1, 0.2, 0.3],
+        "materials": {"grey": {"albedo": 0.5}},
+        "lights": [{"type": "point", "position": [0, 0, -10]}],
+        "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+        "objects": [{"type": "sphere", "radius": 1, "material": "grey"}]
+    })";
+    Scene scene = load_scene_from_string(text, "ambient.json");
+    EXPECT_EQ(scene.ambient(), Vector3(0.2, 0.4, 0.0));
+    EXPECT_EQ(scene.background(), Vector3(0.1, 0.2, 0.3));
+    scene.commit();
+    RenderSettings settings;
+    Vector3 seen = centre_pixel(scene, settings);
+    EXPECT_NEAR(seen.x(), 0.1, 1e-7);
+    EXPECT_NEAR(seen.y(), 0.2, 1e-7);
+    EXPECT_EQ(seen.z(), 0.0);
+    settings.ambient = Vector3(0.0, 0.0, 0.6);
+    seen = centre_pixel(scene, settings);
+    EXPECT_NEAR(seen.y(), 0.2, 1e-7);
+    EXPECT_NEAR(seen.z(), 0.3, 1e-7);
+
+    Camera beside = scene.camera();
+    beside.look_at = Point3(5, 0, 0);
+    scene.set_camera(beside);
+    scene.commit();
+    settings.background = Vector3(0.5, 0.0, 0.0);
+    seen = centre_pixel(scene, settings);
+    EXPECT_NEAR(seen.x(), 0.6, 1e-7);
+    EXPECT_NEAR(seen.y(), 0.2, 1e-7);
+    EXPECT_NEAR(seen.z(), 0.3, 1e-7);
+
+    EXPECT_THROW(scene.set_ambient(Vector3(0, -1, 0)), InvalidParameter);
+    EXPECT_THROW(scene.set_background(Vector3(0, kInfinity, 0)), InvalidParameter);
+    EXPECT_EQ(scene.background(), Vector3(0.1, 0.2, 0.3));  // a refused value leaves it as it was
+}
+
 TEST(PointLight, FallsOffWithTheChosenPowerOfDistance) {
     // A white Lambert plane z = 0 facing a light on its normal at height h, seen head on:
     // radiance = albedo / pi * I / h^k. Two heights give the ratio (h2 / h1)^k.

@@ -48,7 +48,41 @@ struct DirectionalLight {
     Vector3 radiance{1.0, 1.0, 1.0};
 };
 
-using Light = std::variant<PointLight, DirectionalLight>;
+/// Samples per area light by default, and the most a light may ask for.
+inline constexpr int kDefaultAreaLightSamples = 16;
+inline constexpr int kMaxAreaLightSamples = 4096;
+
+/// A parallelogram (a rectangle when the edges are perpendicular) emitting `radiance` from the
+/// side edge_u x edge_v points to: the points corner + a edge_u + b edge_v, a, b in [0, 1].
+/// Shadows are soft: `samples` shadow rays, stratified over its area (render/lights.h).
+struct RectangleLight {
+    Point3 corner{-0.5, 10.0, -0.5};
+    Vector3 edge_u{1.0, 0.0, 0.0};
+    Vector3 edge_v{0.0, 0.0, 1.0};
+    /// Linear RGB radiance, the same at every point and in every direction it emits to.
+    Vector3 radiance{10.0, 10.0, 10.0};
+    int samples = kDefaultAreaLightSamples;
+};
+
+/// A disk emitting `radiance` from the side `normal` points to, sampled like RectangleLight.
+struct DiskLight {
+    Point3 centre{0.0, 10.0, 0.0};
+    Vector3 normal{0.0, -1.0, 0.0};
+    double radius = 1.0;
+    Vector3 radiance{10.0, 10.0, 10.0};
+    int samples = kDefaultAreaLightSamples;
+};
+
+/// A ball emitting `radiance` outward from its surface, sampled over the cone of directions it
+/// fills as seen from the point lit (render/lights.h).
+struct SphereLight {
+    Point3 centre{0.0, 10.0, 0.0};
+    double radius = 1.0;
+    Vector3 radiance{10.0, 10.0, 10.0};
+    int samples = kDefaultAreaLightSamples;
+};
+
+using Light = std::variant<PointLight, DirectionalLight, RectangleLight, DiskLight, SphereLight>;
 
 /// One top-level object of a scene.
 struct SceneObject {
@@ -81,8 +115,18 @@ public:
     /// Throws InvalidParameter for a null shape or an unknown material.
     std::uint32_t add_object(std::shared_ptr<const Shape> shape, std::uint32_t material = 0,
                              std::string name = {});
+    /// Throws InvalidParameter for an area light with a sample count outside
+    /// [1, kMaxAreaLightSamples], a non-finite or negative radiance, a radius <= 0, parallel
+    /// rectangle edges or a zero disk normal.
     void add_light(Light light);
     void set_camera(Camera camera);
+    /// Linear radiance arriving at every surface from every direction, unshadowed: the
+    /// renderer adds albedo * ambient to each opaque surface (classic renderers' ambient term).
+    /// Throws InvalidParameter unless finite and >= 0 per channel.
+    void set_ambient(const Vector3& ambient);
+    /// Linear radiance of rays that hit nothing (camera, mirror and glass rays). Throws
+    /// InvalidParameter unless finite and >= 0 per channel.
+    void set_background(const Vector3& background);
 
     /// Builds everything queries need: validates the camera, computes the bounds, and builds
     /// the objects' ShapeGroup (csg/shape_group.h), a structure over the bounded objects
@@ -105,6 +149,8 @@ public:
     const std::vector<Material>& materials() const { return materials_; }
     const std::vector<Light>& lights() const { return lights_; }
     const Camera& camera() const { return camera_; }
+    const Vector3& ambient() const { return ambient_; }
+    const Vector3& background() const { return background_; }
     /// World bounds of the bounded objects (valid after commit).
     const Aabb& bounds() const { return bounds_; }
 
@@ -121,6 +167,8 @@ private:
     std::vector<Material> materials_;
     std::vector<Light> lights_;
     Camera camera_;
+    Vector3 ambient_{0.0, 0.0, 0.0};
+    Vector3 background_{0.0, 0.0, 0.0};
     Aabb bounds_;
     bool committed_ = false;
     /// Whether the committed scene has any object a ray could hit: without one every query
