@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "csgrt/accel/mesh_io.h"
-#include "csgrt/accel/mesh_tools.h"
+#include "csgrt/mesh/mesh_io.h"
+#include "csgrt/mesh/mesh_tools.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-# Install rules: `cmake --install` puts the four libraries (static, or shared with
+# Install rules: `cmake --install` puts the five libraries (static, or shared with
 # BUILD_SHARED_LIBS=ON), their headers, a CMake package with one component per library, a
 # pkg-config file per library, the csgrt program with its man page, and the docs into the
 # prefix. The CGAL reference and the command-line library are not installed.
@@ -6,7 +6,7 @@ include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(CSGRT_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/csgrt)
-set(CSGRT_INSTALL_COMPONENTS core accel csg render)
+set(CSGRT_INSTALL_COMPONENTS core accel mesh csg render)
 
 # Which packages a component's consumer must find: the public dependencies, and for static
 # libraries the private ones too (they reach the final link). Each entry maps a prefix of the
@@ -77,7 +77,8 @@ endfunction()
 # Every layer below a component, as pkg-config modules (csgrt-core, ...).
 set(CSGRT_LAYERS_BELOW_core "")
 set(CSGRT_LAYERS_BELOW_accel "csgrt-core")
-set(CSGRT_LAYERS_BELOW_csg "csgrt-accel")
+set(CSGRT_LAYERS_BELOW_mesh "csgrt-accel")
+set(CSGRT_LAYERS_BELOW_csg "csgrt-mesh")
 set(CSGRT_LAYERS_BELOW_render "csgrt-csg")
 
 file(RELATIVE_PATH CSGRT_PC_PREFIX_FROM_PCFILEDIR

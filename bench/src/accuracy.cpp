@@ -20,7 +20,7 @@
 
 #include "benchmarks.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/accel/mesh_tools.h"
+#include "csgrt/mesh/mesh_tools.h"
 #include "csgrt/bench/moller_trumbore.h"
 #include "csgrt/bench/statistics.h"
 #include "csgrt/core/polynomial.h"

@@ -10,7 +10,7 @@
 
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/reference/cgal_reference.h"
-#include "csgrt/accel/mesh_io.h"
+#include "csgrt/mesh/mesh_io.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/bench/ray_sets.h"
 #include "csgrt/csg/camera.h"

@@ -11,7 +11,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"

@@ -3,7 +3,7 @@
 #include <pybind11/pybind11.h>
 
 #include "bindings.h"
-#include "csgrt/accel/mesh_io.h"
+#include "csgrt/mesh/mesh_io.h"
 #include "csgrt/core/error.h"
 #include "csgrt/csg/scene_file.h"
 

@@ -8,7 +8,7 @@
 
 #include "bindings.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "queries.h"
 
 namespace csgrt::python {

@@ -10,7 +10,7 @@
 #include <mutex>
 
 #include "bindings.h"
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
 #include "csgrt/csg/boolean.h"

@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
 #include "csgrt/csg/boolean.h"

@@ -23,7 +23,7 @@
 #include "csgrt/accel/brute_force.h"
 #include "csgrt/reference/cgal_reference.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/accel/mesh_io.h"
+#include "csgrt/mesh/mesh_io.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/sphere.h"

@@ -10,7 +10,7 @@
 
 #include "csgrt/accel/closest_point.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/box.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"

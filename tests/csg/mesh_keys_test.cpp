@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/error.h"
 #include "csgrt/csg/scene_file.h"
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <string_view>
 
-#include "csgrt/accel/mesh.h"
-#include "csgrt/accel/mesh_io.h"
+#include "csgrt/mesh/mesh.h"
+#include "csgrt/mesh/mesh_io.h"
 #include "csgrt/core/error.h"
 #include "csgrt/csg/scene.h"
 #include "csgrt/csg/scene_file.h"

@@ -17,7 +17,7 @@
 #include <variant>
 #include <vector>
 
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/camera.h"

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
 #include "stress/reference_shapes.h"

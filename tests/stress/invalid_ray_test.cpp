@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "csgrt/accel/factory.h"
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/shapes.h"

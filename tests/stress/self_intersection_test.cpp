@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/render/shadow_offset.h"

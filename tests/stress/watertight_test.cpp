@@ -24,8 +24,8 @@
 
 #include "csgrt/reference/cgal_reference.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/accel/mesh_io.h"
-#include "csgrt/accel/mesh_tools.h"
+#include "csgrt/mesh/mesh_io.h"
+#include "csgrt/mesh/mesh_tools.h"
 #include "csgrt/accel/triangle_set.h"
 #include "stress/stress_config.h"
 #include "stress/summary.h"

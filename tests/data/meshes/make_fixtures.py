@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the tiny mesh fixtures of tests/accel/mesh_io_test.cpp into this folder.
+"""Writes the tiny mesh fixtures of tests/mesh/mesh_io_test.cpp into this folder.
 
 The files are committed; rerun this only to change them. Valid files all describe the box
 [0,2] x [0,3] x [0,4] (8 vertices, 12 triangles, volume 24, outward winding) in every format;

@@ -1,25 +1,29 @@
-// csgrt::accel (or csgrt::mesh) alone: a BVH over a two-triangle square in the plane z = 1
-// finds it at t = 1 from the origin looking up z, and misses beside it.
-#include <csgrt/accel/mesh.h>
+// csgrt::accel alone: a BVH over a two-triangle square in the plane z = 1 finds it at t = 1
+// from the origin looking up z, and misses beside it. (The Mesh shape is csgrt::mesh's.)
+#include <csgrt/accel/factory.h>
+#include <csgrt/accel/triangle_set.h>
+#include <csgrt/core/query_scratch.h>
 
 #include <cstdio>
+#include <vector>
 
 int main() {
-    csgrt::TriangleMeshData square;
-    square.vertices = {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
-    square.triangles = {{0, 1, 2}, {0, 2, 3}};
-    csgrt::MeshConfig config;
-    config.accelerator = "bvh";
-    const csgrt::Mesh mesh(square, config);
+    const std::vector<Eigen::Vector3d> vertices = {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
+    const std::vector<std::array<std::uint32_t, 3>> triangles = {{0, 1, 2}, {0, 2, 3}};
+    const csgrt::TriangleSet<float> square(vertices, triangles);
+    const auto bvh = csgrt::make_accelerator("bvh", square);
+    csgrt::QueryScratch scratch;
     csgrt::Ray ray;
     ray.origin = csgrt::Point3(0.25, 0.5, 0);
     ray.direction = csgrt::Vector3(0, 0, 1);
-    const auto hit = mesh.intersect(ray);
+    csgrt::HitRecord hit;
+    const bool found = bvh->intersect(ray, hit, scratch);
     ray.origin = csgrt::Point3(2, 0, 0);
-    if (!hit || hit->t != 1.0 || mesh.intersect(ray)) {
+    csgrt::HitRecord miss;
+    if (!found || hit.t != 1.0 || bvh->intersect(ray, miss, scratch)) {
         std::printf("accel: expected a hit at t = 1 and then a miss\n");
         return 1;
     }
-    std::printf("accel: t = %g\n", hit->t);
+    std::printf("accel: t = %g\n", hit.t);
     return 0;
 }

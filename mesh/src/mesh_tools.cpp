@@ -1,4 +1,4 @@
-#include "csgrt/accel/mesh_tools.h"
+#include "csgrt/mesh/mesh_tools.h"
 
 // OpenMesh's properties default-construct their vectors uninitialised by design; GCC's
 // -Wmaybe-uninitialized flags that inside its headers at -O1 (the asan preset). Clang has no

@@ -1,4 +1,4 @@
-#include "csgrt/accel/mesh_io.h"
+#include "csgrt/mesh/mesh_io.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include <set>
 #include <sstream>
 
-#include "csgrt/accel/mesh_tools.h"
+#include "csgrt/mesh/mesh_tools.h"
 #include "csgrt/core/error.h"
 #include "support/meshes.h"
 #include "support/real_meshes.h"

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "csgrt/accel/mesh.h"
-#include "csgrt/accel/mesh_tools.h"
+#include "csgrt/mesh/mesh.h"
+#include "csgrt/mesh/mesh_tools.h"
 #include "support/meshes.h"
 #include "support/random.h"
 

@@ -12,7 +12,7 @@
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/accelerator_config.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/accel/mesh_io.h"
+#include "csgrt/mesh/mesh_io.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/shape.h"
 

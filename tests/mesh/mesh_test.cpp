@@ -1,4 +1,4 @@
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 
 #include <cstddef>
 
-#include "csgrt/accel/mesh_io.h"
+#include "csgrt/mesh/mesh_io.h"
 
 namespace csgrt {
 

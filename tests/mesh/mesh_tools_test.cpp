@@ -1,4 +1,4 @@
-#include "csgrt/accel/mesh_tools.h"
+#include "csgrt/mesh/mesh_tools.h"
 
 #include <gtest/gtest.h>
 

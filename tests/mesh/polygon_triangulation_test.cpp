@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "csgrt/accel/mesh_io.h"
+#include "csgrt/mesh/mesh_io.h"
 #include "csgrt/core/math.h"
 #include "support/test_scale.h"
 

@@ -1,4 +1,4 @@
-#include "csgrt/accel/mesh.h"
+#include "csgrt/mesh/mesh.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -6,8 +6,8 @@
 #include <limits>
 #include <type_traits>
 
-#include "csgrt/accel/mesh_tools.h"
 #include "csgrt/core/error.h"
+#include "csgrt/mesh/mesh_tools.h"
 
 namespace csgrt {
 
