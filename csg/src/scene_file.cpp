@@ -668,7 +668,7 @@ public:
         if (definitions_ != nullptr) {
             tokens_.push_back("definitions");
             for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
-                definition(it.key(), it.value());
+                definition(it.key(), it.value(), 0);
             }
             tokens_.pop_back();
         }
@@ -686,12 +686,12 @@ public:
     }
 
 private:
-    std::uint64_t definition(const std::string& name, const Json& body) {
+    std::uint64_t definition(const std::string& name, const Json& body, std::size_t depth) {
         if (const auto found = counted_.find(name); found != counted_.end()) return found->second;
         // A cycle is the loader's to report; it counts as one leaf here.
         if (!in_progress_.insert(name).second) return 1;
         tokens_.push_back(name);
-        const std::uint64_t leaves = node(body, 0);
+        const std::uint64_t leaves = node(body, depth + 1);
         tokens_.pop_back();
         in_progress_.erase(name);
         counted_.emplace(name, leaves);
@@ -719,7 +719,7 @@ private:
                     // The definition's own tokens replace this node's in a message.
                     std::vector<std::string> saved = std::move(tokens_);
                     tokens_ = {"definitions"};
-                    leaves = definition(target->get_ref<const std::string&>(), *body);
+                    leaves = definition(target->get_ref<const std::string&>(), *body, depth);
                     tokens_ = std::move(saved);
                 }
             }
@@ -756,37 +756,43 @@ private:
                     ? std::numeric_limits<std::uint64_t>::max()
                     : copies * static_cast<std::uint64_t>(n);
         }
+        // Over one grid's copy limit: the loader refuses it before building its item.
+        if (copies > kMaxGridCopies) return 1;
         tokens_.push_back("item");
         const std::uint64_t item_leaves = node(*item, depth + 1);
         tokens_.pop_back();
         if (item_leaves != 0 && copies > kMaxExpandedLeaves / item_leaves) {
             tokens_.push_back("count");
-            source_.fail(pointer(), (copies == std::numeric_limits<std::uint64_t>::max()
-                                         ? std::string("at least 2^64 - 1")
-                                         : std::to_string(copies)) +
-                                        " copies of an item of " + std::to_string(item_leaves) +
-                                        " leaf shapes are more than the " +
-                                        std::to_string(kMaxExpandedLeaves) +
-                                        " leaves a scene may expand to (docs/scene-format.md, "
-                                        "Limits)");
+            std::string message = count_text(copies);
+            message.append(" copies of an item of ").append(std::to_string(item_leaves));
+            message.append(" leaf shapes are more than the ");
+            message.append(std::to_string(kMaxExpandedLeaves));
+            message.append(" leaves a scene may expand to (docs/scene-format.md, Limits)");
+            source_.fail(pointer(), message);
         }
         return copies * item_leaves;
     }
 
+    /// A count for a message; the saturated count is a lower bound.
+    static std::string count_text(std::uint64_t count) {
+        return count == std::numeric_limits<std::uint64_t>::max() ? "at least 2^64 - 1"
+                                                                  : std::to_string(count);
+    }
+
     [[noreturn]] void too_many(std::uint64_t leaves) const {
-        source_.fail(pointer(), "the scene expands to " +
-                                    (leaves == std::numeric_limits<std::uint64_t>::max()
-                                         ? std::string("at least 2^64 - 1")
-                                         : std::to_string(leaves)) +
-                                    " leaf shapes up to here (every grid copy and every use of a "
-                                    "definition counts); at most " +
-                                    std::to_string(kMaxExpandedLeaves) +
-                                    " are allowed (docs/scene-format.md, Limits)");
+        // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on chained string +.
+        std::string message = "the scene expands to ";
+        message.append(count_text(leaves));
+        message.append(" leaf shapes up to here (every grid copy and every use of a definition ");
+        message.append("counts); at most ").append(std::to_string(kMaxExpandedLeaves));
+        message.append(" are allowed (docs/scene-format.md, Limits)");
+        source_.fail(pointer(), message);
     }
 
     std::string pointer() const {
         std::string text;
-        for (const std::string& token : tokens_) text += "/" + escape_pointer_token(token);
+        for (const std::string& token : tokens_)
+            text.append("/").append(escape_pointer_token(token));
         return text;
     }
 
