@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <utility>
 
 namespace csgrt {
 
@@ -15,7 +16,18 @@ namespace csgrt {
 /// names the thing, the parameter and the value: "Sphere: radius must be > 0 and finite, got -1".
 class InvalidParameter : public std::invalid_argument {
 public:
-    using std::invalid_argument::invalid_argument;
+    /// An error whose message names no single parameter (parameter() is empty).
+    explicit InvalidParameter(const std::string& message) : std::invalid_argument(message) {}
+    /// An error about `parameter` ("radius", "phi_max", "name"): callers such as the scene
+    /// loader point at the key of that name without parsing the message.
+    InvalidParameter(const std::string& message, std::string parameter)
+        : std::invalid_argument(message), parameter_(std::move(parameter)) {}
+
+    /// The parameter the error is about, as the thrower named it; empty when none was named.
+    const std::string& parameter() const { return parameter_; }
+
+private:
+    std::string parameter_;
 };
 
 namespace detail {
@@ -42,7 +54,7 @@ void require(bool ok, std::string_view what, std::string_view parameter,
     std::string message;
     message.append(what).append(": ").append(parameter).append(" must be ");
     message.append(expectation).append(", got ").append(detail::describe(value));
-    throw InvalidParameter(message);
+    throw InvalidParameter(message, std::string(parameter));
 }
 
 /// `require` for the common case of a strictly positive, finite length.

@@ -29,6 +29,8 @@ public:
     /// world space.
     Hit to_world(const Hit& object_hit) const;
 
+    /// The one shape under the transform.
+    std::vector<const Shape*> children() const override { return {shape_.get()}; }
     const Shape& shape() const { return *shape_; }
     const std::shared_ptr<const Shape>& shared_shape() const { return shape_; }
     const Transform& world_from_object() const { return world_from_object_; }

@@ -2,6 +2,7 @@
 
 #include <optional>
 #include <string_view>
+#include <vector>
 
 #include "csgrt/core/aabb.h"
 #include "csgrt/core/hit.h"
@@ -39,6 +40,11 @@ public:
     /// True for closed solids: `find_spans` and `contains` are defined and the shape may be a
     /// CSG operand.
     virtual bool is_solid() const { return false; }
+
+    /// The shapes this one is made of, in order (an instance's shape, a boolean's operands, a
+    /// compound's children); empty for a leaf. For walking a tree (counting, printing), never
+    /// on a query's path: it allocates.
+    virtual std::vector<const Shape*> children() const { return {}; }
 
     /// Finds the nearest hit with t in [ray.t_min, ray.t_max]. On success overwrites `record`
     /// (every field) and returns true; otherwise leaves `record` alone. Callers narrow

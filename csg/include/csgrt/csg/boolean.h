@@ -39,6 +39,8 @@ public:
     bool contains(const Point3& p) const override;
 
     BooleanOperation operation() const { return operation_; }
+    /// The two operands, first then second.
+    std::vector<const Shape*> children() const override { return {first_.get(), second_.get()}; }
     const Shape& first() const { return *first_; }
     const Shape& second() const { return *second_; }
     const std::shared_ptr<const Shape>& shared_first() const { return first_; }

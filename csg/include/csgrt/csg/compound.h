@@ -61,7 +61,13 @@ public:
 
     std::size_t size() const { return children_.size(); }
     const Shape& child(std::size_t i) const { return *children_[i]; }
-    const std::vector<std::shared_ptr<const Shape>>& children() const { return children_; }
+    /// The children, in the order given.
+    std::vector<const Shape*> children() const override {
+        std::vector<const Shape*> shapes;
+        shapes.reserve(children_.size());
+        for (const auto& child : children_) shapes.push_back(child.get());
+        return shapes;
+    }
     /// The structure over the bounded children ("" when there are none), why it was chosen,
     /// and its figures.
     std::string_view accelerator_name() const;
