@@ -1,0 +1,93 @@
+#include "fields.h"
+
+namespace csgrt::detail::scene_file {
+
+Fields::Fields(const Json& value, std::string pointer, const Source& source, std::string_view what)
+    : value_(value), pointer_(std::move(pointer)), source_(source), what_(what) {
+    if (!value_.is_object()) {
+        source_.fail(pointer_, "expected an object (" + what_ + "), got " + describe(value_));
+    }
+}
+
+const Json& Fields::required(std::string_view key, std::string_view expected) {
+    ask(key);
+    const auto found = value_.find(key);
+    if (found == value_.end()) {
+        source_.fail(pointer_, "missing required key \"" + std::string(key) + "\" (" +
+                                   std::string(expected) + ") in " + what_);
+    }
+    return *found;
+}
+
+bool Fields::boolean(std::string_view key, bool fallback) {
+    if (!has(key)) return fallback;
+    const Json& value = value_.at(key);
+    if (!value.is_boolean()) fail(key, "expected true or false, got " + describe(value));
+    return value.get<bool>();
+}
+
+std::string Fields::string(std::string_view key) {
+    const Json& value = required(key, "a string");
+    if (!value.is_string()) fail(key, "expected a string, got " + describe(value));
+    return value.get<std::string>();
+}
+
+Vector3 Fields::colour(std::string_view key, const Vector3& fallback) {
+    if (!has(key)) return fallback;
+    const Json& value = value_.at(key);
+    if (value.is_number()) return Vector3::Constant(to_number(value, pointer(key)));
+    return to_vector(value, pointer(key));
+}
+
+const Json& Fields::array(std::string_view key, std::size_t minimum, std::string_view of) {
+    const Json& value = required(key, "an array of " + std::string(of));
+    if (!value.is_array()) {
+        fail(key, "expected an array of " + std::string(of) + ", got " + describe(value));
+    }
+    if (value.size() < minimum) {
+        fail(key, "expected at least " + std::to_string(minimum) + " " + std::string(of) +
+                      ", got " + std::to_string(value.size()));
+    }
+    return value;
+}
+
+void Fields::finish() const {
+    for (auto it = value_.begin(); it != value_.end(); ++it) {
+        if (std::find(asked_.begin(), asked_.end(), it.key()) != asked_.end()) continue;
+        std::string message = "unknown key " + quote_name(it.key()) + " in " + what_;
+        if (it.key() == "material" || it.key() == "name") {
+            message += " (\"" + it.key() + "\" belongs to the top-level objects)";
+        } else if (it.key() == "materials") {
+            message += " (\"materials\" belongs to top-level grids)";
+        }
+        std::string known;
+        for (const std::string& key : asked_) known += (known.empty() ? "" : ", ") + key;
+        source_.fail(pointer(it.key()), message + "; expected one of: " + known);
+    }
+}
+
+double Fields::to_number(const Json& value, const std::string& at) const {
+    if (!value.is_number()) source_.fail(at, "expected a number, got " + describe(value));
+    const double number = value.get<double>();
+    // JSON has no NaN or infinity, but a literal like 1e999 overflows to infinity.
+    if (!std::isfinite(number)) source_.fail(at, "expected a finite number, got " + value.dump());
+    return number;
+}
+
+std::size_t Fields::to_count(const Json& value, const std::string& at) const {
+    if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
+        source_.fail(at, "expected a whole number >= 0, got " + describe(value));
+    }
+    return value.get<std::size_t>();
+}
+
+Vector3 Fields::to_vector(const Json& value, const std::string& at) const {
+    if (!value.is_array() || value.size() != 3) {
+        source_.fail(at, "expected an array of 3 numbers, got " + describe(value));
+    }
+    return Vector3(to_number(value[0], child_pointer(at, 0)),
+                   to_number(value[1], child_pointer(at, 1)),
+                   to_number(value[2], child_pointer(at, 2)));
+}
+
+}  // namespace csgrt::detail::scene_file

@@ -1,0 +1,124 @@
+#pragma once
+
+// The loader: from a parsed scene file to a Scene, node by node, with the shape table, the
+// transforms, the settings (camera, materials, lights) and the limits each in a file of its own.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "csgrt/core/error.h"
+#include "csgrt/core/transform.h"
+#include "csgrt/csg/scene.h"
+#include "fields.h"
+
+namespace csgrt::detail::scene_file {
+
+class Loader;
+
+/// One entry of the shape table: the "type" keyword and how to build it from its fields.
+/// Adding a shape to the format is one entry here.
+struct ShapeEntry {
+    std::string_view type;
+    ShapePointer (*build)(Fields& fields, Loader& loader);
+    /// Whether the entry reads angles (in degrees; the shapes take radians).
+    bool angles = false;
+};
+
+/// A place in a list (objects, children, operands) after grids are expanded: the shape and
+/// the pointer of the node it came from.
+struct ListItem {
+    ShapePointer shape;
+    std::string pointer;
+};
+
+class Loader {
+public:
+    Loader(const Json& root, const Source& source) : root_(root), source_(source) {}
+
+    Scene load();
+
+    /// Builds the shape described by the node at `pointer`; `fields` may already have had
+    /// top-level keys read from it.
+    ShapePointer shape(Fields& fields);
+    ShapePointer shape(const Json& value, const std::string& pointer, std::string_view what) {
+        Fields fields(value, pointer, source_, what);
+        ShapePointer built = shape(fields);
+        fields.finish();
+        return built;
+    }
+
+    /// The shapes of an array of nodes, with every grid replaced by its copies.
+    std::vector<ListItem> list(Fields& fields, std::string_view key, std::size_t minimum,
+                               std::string_view of);
+
+    /// The copies of a grid node, each its item moved into place.
+    std::vector<ShapePointer> grid(Fields& fields);
+
+    ShapePointer definition(const std::string& name, const std::string& pointer);
+
+    /// A mesh node: the file at "path", relative to the scene file's folder, loaded once per
+    /// path and settings however often it is named.
+    ShapePointer mesh(Fields& fields);
+
+    const Source& source() const { return source_; }
+
+    Transform transform(const Json& list, const std::string& pointer) const;
+
+private:
+    void camera(Scene& scene);
+    void materials(Scene& scene, std::map<std::string, std::uint32_t>& by_name);
+    void lights(Scene& scene);
+    void ambient_and_background(Scene& scene);
+
+    /// Counts `shape`'s expanded leaves into the scene's total and fails at `pointer` once the
+    /// total passes kMaxExpandedLeaves.
+    void count_leaves(const Shape& shape, const std::string& pointer);
+
+    const Json& root_;
+    const Source& source_;
+    const Json* definitions_ = nullptr;
+    /// The definitions by name, so a ref costs a hash look-up, not a scan of the object.
+    std::unordered_map<std::string, const Json*> definition_index_;
+    std::map<std::string, ShapePointer> built_;
+    /// Shapes being built, one per nesting level (refs included), against kMaxShapeDepth.
+    std::size_t depth_ = 0;
+    /// Each distinct shape's count of expanded leaves, so shared subtrees are counted once.
+    std::unordered_map<const Shape*, std::uint64_t> leaves_;
+    std::uint64_t total_leaves_ = 0;
+    std::map<std::string, ShapePointer> meshes_;
+    /// Definitions being built, outermost first: a name met again here is a cycle.
+    std::vector<std::string> building_;
+};
+
+/// The entry of the shape table for `type`, or null (shape_table.cpp).
+const ShapeEntry* find_entry(std::string_view type);
+
+/// Every type of the shape table, comma-separated, for a message.
+std::string known_types();
+
+/// Turns a shape's InvalidParameter ("Sphere: radius must be > 0 ...") into a SceneError at the
+/// key the message names, when the node has that key, else at the node.
+[[noreturn]] void rethrow_invalid(const InvalidParameter& error, const Fields& fields,
+                                  const Json& node, bool angles);
+
+/// `shape` placed by `world_from_object`; nested instances are folded into one.
+ShapePointer place(ShapePointer shape, const Transform& world_from_object);
+
+/// The leaves of the tree under `shape` with every shared subtree counted once per use,
+/// memoised per distinct shape: linear in the distinct shapes, whatever the expansion.
+std::uint64_t expanded_leaves(const Shape& shape,
+                              std::unordered_map<const Shape*, std::uint64_t>& memo);
+
+/// Counts the expanded leaves the parsed file `root` describes before anything is built, and
+/// fails (SceneError) where they pass kMaxExpandedLeaves (leaf_limits.cpp).
+void prescan_leaves(const Json& root, const Source& source);
+
+/// The parsed JSON tree of `text`; a SceneError for invalid JSON, a duplicate key or nesting
+/// deeper than kMaxJsonDepth (json_tree.cpp).
+Json parse_scene_json(std::string_view text, const Source& source);
+
+}  // namespace csgrt::detail::scene_file

@@ -1,0 +1,49 @@
+#pragma once
+
+// Messages about a scene file: names and values from the file shown safely, JSON pointers, and
+// the one place a SceneError is thrown from.
+
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+
+#include "csgrt/core/shape.h"
+
+namespace csgrt::detail::scene_file {
+
+// ordered_json keeps the file's order, so materials get indices in the order they are written.
+using Json = nlohmann::ordered_json;
+using ShapePointer = std::shared_ptr<const Shape>;
+
+/// A name from the file for a message: control characters escaped, cut after
+/// kLongestShownName bytes.
+std::string shown(std::string_view name);
+
+/// `shown`, in double quotes.
+std::string quote_name(std::string_view name);
+
+/// `token` as one step of a JSON pointer (RFC 6901: '~' and '/' escaped), shown safely.
+std::string escape_pointer_token(std::string_view token);
+
+std::string child_pointer(const std::string& pointer, std::string_view key);
+std::string child_pointer(const std::string& pointer, std::size_t index);
+
+/// A JSON value in a few words, for "expected ..., got ..." messages.
+std::string describe(const Json& value);
+
+/// A pointer for a message: a very deep one (the nesting limits are met 500 levels down)
+/// keeps its first and last 120 characters around the count of the levels left out.
+std::string shown_pointer(const std::string& pointer);
+
+/// Where in which file: everything a message needs besides what went wrong.
+struct Source {
+    std::string name;
+    std::filesystem::path directory;
+
+    /// Throws the SceneError "name: pointer: message".
+    [[noreturn]] void fail(const std::string& pointer, const std::string& message) const;
+};
+
+}  // namespace csgrt::detail::scene_file
