@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <limits>
 #include <new>
-#include <optional>
 #include <span>
 #include <type_traits>
 
@@ -218,7 +217,9 @@ struct BoxRay {
     int near_row(int axis, int width) const {
         return (2 * axis + (negative[axis] ? 1 : 0)) * width;
     }
-    int far_row(int axis, int width) const { return (2 * axis + (negative[axis] ? 0 : 1)) * width; }
+    int far_row(int axis, int width) const {
+        return (2 * axis + (negative[axis] ? 0 : 1)) * width;
+    }
 };
 
 /// Conservative slab test of one binary node's box: [t_enter, t_exit] clipped to
@@ -339,9 +340,11 @@ struct Avx2NodeTest {
 };
 #endif
 
-/// Four triangles of a block sheared into the frame of the ray, lane by lane.
+/// Four triangles of a block sheared into the frame of the ray, lane by lane, with their edge
+/// functions.
 struct ShearedBlock {
     Float4 x[3], y[3], z[3];
+    Float4 u, v, w;
 
     /// Lane l as the set's scalar test would have computed it.
     TriangleSet<float>::ShearedTriangle lane(int l) const {
@@ -361,11 +364,55 @@ struct ShearedBlock {
     }
 };
 
+/// t and the barycentrics of corners 1 and 2 of a block's four lanes, from their edge
+/// functions: TriangleSet::hit_sheared's double arithmetic after its sign test, lane by lane in
+/// the same order (no fused multiply-add), so the same bits for a lane whose edge functions
+/// are non-zero and of one sign. Two lanes at a time with SSE2; one division for all four.
+struct BlockHits {
+    alignas(16) double t[4], b1[4], b2[4];
+
+    BlockHits(const ShearedBlock& block, double shear_z) {
+#if defined(__SSE2__)
+        const __m128d scale = _mm_set1_pd(shear_z), one = _mm_set1_pd(1.0);
+        for (int half = 0; half < 2; ++half) {
+            auto widen = [half](Float4 lanes) {
+                return _mm_cvtps_pd(half == 0 ? lanes.v : _mm_movehl_ps(lanes.v, lanes.v));
+            };
+            const __m128d u = widen(block.u), v = widen(block.v), w = widen(block.w);
+            const __m128d az = _mm_mul_pd(scale, widen(block.z[0]));
+            const __m128d bz = _mm_mul_pd(scale, widen(block.z[1]));
+            const __m128d cz = _mm_mul_pd(scale, widen(block.z[2]));
+            const __m128d scaled_t =
+                _mm_add_pd(_mm_add_pd(_mm_mul_pd(u, az), _mm_mul_pd(v, bz)), _mm_mul_pd(w, cz));
+            const __m128d inverse = _mm_div_pd(one, _mm_add_pd(_mm_add_pd(u, v), w));
+            _mm_store_pd(t + 2 * half, _mm_mul_pd(scaled_t, inverse));
+            _mm_store_pd(b1 + 2 * half, _mm_mul_pd(v, inverse));
+            _mm_store_pd(b2 + 2 * half, _mm_mul_pd(w, inverse));
+        }
+#else
+        alignas(16) float u[4], v[4], w[4], z[3][4];
+        block.u.store(u);
+        block.v.store(v);
+        block.w.store(w);
+        for (int k = 0; k < 3; ++k) block.z[k].store(z[k]);
+        for (int l = 0; l < 4; ++l) {
+            const double az = shear_z * double(z[0][l]), bz = shear_z * double(z[1][l]),
+                         cz = shear_z * double(z[2][l]);
+            const double scaled_t = double(u[l]) * az + double(v[l]) * bz + double(w[l]) * cz;
+            const double inverse = 1.0 / (double(u[l]) + double(v[l]) + double(w[l]));
+            t[l] = scaled_t * inverse;
+            b1[l] = double(v[l]) * inverse;
+            b2[l] = double(w[l]) * inverse;
+        }
+#endif
+    }
+};
+
 /// The first half of TriangleSet<float>'s test on the four triangles of a block at once: the
 /// same float operations as TriangleSet::shear and the edge functions of hit_sheared, lane by
 /// lane, so the values are the scalar test's bits. A lane whose three edge functions are
 /// non-zero and of mixed signs is a miss for the scalar test too (it only recomputes exact
-/// zeros); every other lane is left to TriangleSet::hit_sheared.
+/// zeros).
 struct BlockRay {
     /// The origin's and the shear's components, on the permuted axes (x, y, z of the test).
     Float4 origin[3], shear_x, shear_y;
@@ -379,8 +426,12 @@ struct BlockRay {
         for (int a = 0; a < 3; ++a) origin[a] = Float4::broadcast(ray.origin[axis[a]]);
     }
 
-    /// The lanes that may hit (bit l for lane l), and the block sheared for those.
-    unsigned candidates(const BvhTriangleBlock& block, ShearedBlock& sheared) const {
+    /// The lanes that may hit (bit l for lane l), the block sheared, and in `zeros` the lanes
+    /// with an edge function that is exactly zero (left to TriangleSet::hit_sheared, which
+    /// recomputes those in double). Every other candidate lane is a hit whose t and
+    /// barycentrics BlockHits gives.
+    unsigned candidates(const BvhTriangleBlock& block, ShearedBlock& sheared,
+                        unsigned& zeros) const {
         for (int k = 0; k < 3; ++k) {
             const Float4 px = Float4::load_aligned(block.corners[k][axis[0]]) - origin[0];
             const Float4 py = Float4::load_aligned(block.corners[k][axis[1]]) - origin[1];
@@ -391,16 +442,86 @@ struct BlockRay {
         }
         const Float4* x = sheared.x;
         const Float4* y = sheared.y;
-        const Float4 u = x[2] * y[1] - y[2] * x[1];
-        const Float4 v = x[0] * y[2] - y[0] * x[2];
-        const Float4 w = x[1] * y[0] - y[1] * x[0];
+        const Float4 u = sheared.u = x[2] * y[1] - y[2] * x[1];
+        const Float4 v = sheared.v = x[0] * y[2] - y[0] * x[2];
+        const Float4 w = sheared.w = x[1] * y[0] - y[1] * x[0];
         const Float4 zero = Float4::broadcast(0.0f);
-        const Float4 some_zero = equal(u, zero) | equal(v, zero) | equal(w, zero);
-        const Float4 some_negative = (u < zero) | (v < zero) | (w < zero);
-        const Float4 some_positive = (u > zero) | (v > zero) | (w > zero);
-        return ~and_not(some_zero, some_negative & some_positive).mask() & 0xfu;
+        zeros = (equal(u, zero) | equal(v, zero) | equal(w, zero)).mask();
+        // Non-zero numbers' signs are their sign bits: mixed when some but not all are set.
+        // (A lane with a NaN gets a NaN t, kept or dropped here, and no query keeps it.)
+        const unsigned some_negative = (u | v | w).mask(), all_negative = (u & v & w).mask();
+        return (zeros | ~(some_negative & ~all_negative)) & 0xfu;
     }
 };
+
+#if CSGRT_BVH_AVX2
+/// BlockRay::candidates on two consecutive blocks at once, lanes 0-3 the first and 4-7 the
+/// second, in 8-lane AVX2 steps: the same operations lane by lane (no fused multiply-add), so
+/// the same bits. Most leaves hold five to eight triangles, two blocks.
+struct Avx2BlockRay {
+    __m256 origin[3], shear_x, shear_y;
+    int axis[3];
+
+    [[gnu::target("avx2")]] explicit Avx2BlockRay(const BlockRay& ray) {
+        for (int a = 0; a < 3; ++a) {
+            origin[a] = _mm256_set_m128(ray.origin[a].v, ray.origin[a].v);
+            axis[a] = ray.axis[a];
+        }
+        shear_x = _mm256_set_m128(ray.shear_x.v, ray.shear_x.v);
+        shear_y = _mm256_set_m128(ray.shear_y.v, ray.shear_y.v);
+    }
+
+    // (Lambdas would not inherit the target attribute: these are functions.)
+    [[gnu::target("avx2")]] static __m256 load(const BvhTriangleBlock& first,
+                                               const BvhTriangleBlock& second, int k, int a) {
+        return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(first.corners[k][a])),
+                                    _mm_load_ps(second.corners[k][a]), 1);
+    }
+    [[gnu::target("avx2")]] static void split(__m256 lanes, Float4& low, Float4& high) {
+        low.v = _mm256_castps256_ps128(lanes);
+        high.v = _mm256_extractf128_ps(lanes, 1);
+    }
+
+    /// As BlockRay::candidates, bits 0-3 for `first` and 4-7 for `second`; `sheared` is
+    /// written only when some lane is a candidate.
+    [[gnu::target("avx2")]] unsigned candidates(const BvhTriangleBlock& first,
+                                                const BvhTriangleBlock& second,
+                                                ShearedBlock (&sheared)[2], unsigned& zeros) const {
+        __m256 x[3], y[3], z[3];
+        for (int k = 0; k < 3; ++k) {
+            const __m256 px = _mm256_sub_ps(load(first, second, k, axis[0]), origin[0]);
+            const __m256 py = _mm256_sub_ps(load(first, second, k, axis[1]), origin[1]);
+            const __m256 pz = _mm256_sub_ps(load(first, second, k, axis[2]), origin[2]);
+            x[k] = _mm256_sub_ps(px, _mm256_mul_ps(shear_x, pz));
+            y[k] = _mm256_sub_ps(py, _mm256_mul_ps(shear_y, pz));
+            z[k] = pz;
+        }
+        const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
+        const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
+        const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
+        const __m256 zero = _mm256_setzero_ps();
+        zeros = static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(
+            _mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
+            _mm256_cmp_ps(w, zero, _CMP_EQ_OQ))));
+        const unsigned some_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(u, v), w)));
+        const unsigned all_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(u, v), w)));
+        const unsigned result = (zeros | ~(some_negative & ~all_negative)) & 0xffu;
+        if (result != 0) {
+            for (int k = 0; k < 3; ++k) {
+                split(x[k], sheared[0].x[k], sheared[1].x[k]);
+                split(y[k], sheared[0].y[k], sheared[1].y[k]);
+                split(z[k], sheared[0].z[k], sheared[1].z[k]);
+            }
+            split(u, sheared[0].u, sheared[1].u);
+            split(v, sheared[0].v, sheared[1].v);
+            split(w, sheared[0].w, sheared[1].w);
+        }
+        return result;
+    }
+};
+#endif
 
 /// Everything the queries do, for each layout and instruction set; a friend of Bvh.
 template <class Set>
@@ -421,15 +542,21 @@ struct BvhTraversal {
     /// Visits every leaf the ray may hit within [t_min, t_max], nearest entry first. `leaf`
     /// is called as leaf(first, count, t_max) with the leaf's reference (see Bvh::
     /// binary_nodes) and the float upper bound of the interval, which it may lower; it
-    /// returns true to stop.
-    template <bool kCount, class Leaf>
+    /// returns true to stop. kAvx2: the 8-wide tree with the AVX2 node test (run_avx2 only).
+    template <bool kCount, bool kAvx2, class Leaf>
     static void traverse(const Tree& bvh, const Ray& ray, const BoxRay& box_ray,
                          TraversalCounters& counters, Leaf& leaf) {
-        if (bvh.config_.width == 8) {
 #if CSGRT_BVH_AVX2
-            if (bvh.use_avx2_)
-                return traverse_avx2<kCount>(bvh, box_ray, ray.t_max, counters, leaf);
+        if constexpr (kAvx2) {
+            if (box_ray.signed_interval) {
+                return traverse_wide<kCount, true, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray,
+                                                                 ray.t_max, counters, leaf);
+            }
+            return traverse_wide<kCount, false, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray, ray.t_max,
+                                                              counters, leaf);
+        }
 #endif
+        if (bvh.config_.width == 8) {
             if (box_ray.signed_interval) {
                 return traverse_wide<kCount, true, SseNodeTest<8>>(bvh, bvh.nodes_8_, box_ray,
                                                                    ray.t_max, counters, leaf);
@@ -451,23 +578,31 @@ struct BvhTraversal {
         traverse_binary<kCount, false>(bvh, box_ray, ray.t_max, counters, leaf);
     }
 
-#if CSGRT_BVH_AVX2
-    /// The 8-wide traversal with the AVX2 node test. `flatten` inlines everything it calls
-    /// (the traversal, the leaf visitor, the triangle test), so all of it is compiled for
-    /// AVX2 here and nowhere else.
-    template <bool kCount, class Leaf>
-    [[gnu::target("avx2"), gnu::flatten]] static void traverse_avx2(const Tree& bvh,
-                                                                    const BoxRay& box_ray,
-                                                                    double t_max,
-                                                                    TraversalCounters& counters,
-                                                                    Leaf& leaf) {
-        if (box_ray.signed_interval) {
-            traverse_wide<kCount, true, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray, t_max, counters,
-                                                      leaf);
+    /// One query of kind kKind, with the AVX2 node test when kAvx2.
+    template <QueryKind kKind, bool kCount, bool kAvx2>
+    static bool run(const Tree& bvh, const Ray& ray, QueryAnswer<kKind>& answer,
+                    QueryScratch& scratch, TraversalCounters& counters) {
+        if constexpr (kKind == QueryKind::kNearest) {
+            return intersect<kCount, kAvx2>(bvh, ray, answer, scratch, counters);
+        } else if constexpr (kKind == QueryKind::kAny) {
+            return occluded<kCount, kAvx2>(bvh, ray, scratch, counters);
         } else {
-            traverse_wide<kCount, false, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray, t_max, counters,
-                                                       leaf);
+            const std::size_t before = answer.size();
+            all_hits<kAvx2>(bvh, ray, answer, scratch);
+            return answer.size() > before;
         }
+    }
+
+#if CSGRT_BVH_AVX2
+    /// The whole query compiled for AVX2: `flatten` inlines everything it calls (the ray's
+    /// set-up, the traversal, the leaf visitor, the triangle test), so all of it is AVX2 code,
+    /// here and nowhere else, with no call between the set-up and the traversal.
+    template <QueryKind kKind, bool kCount>
+    [[gnu::target("avx2"), gnu::flatten]] static bool run_avx2(const Tree& bvh, const Ray& ray,
+                                                               QueryAnswer<kKind>& answer,
+                                                               QueryScratch& scratch,
+                                                               TraversalCounters& counters) {
+        return run<kKind, kCount, true>(bvh, ray, answer, scratch, counters);
     }
 #endif
 
@@ -576,7 +711,21 @@ struct BvhTraversal {
                 first = node.first[nearest];
                 count = node.count[nearest];
                 if (mask == 0) continue;
-                // Two or more children: push them all, then order the pushed entries so that
+                if ((mask & (mask - 1)) == 0) {
+                    // Two children (the common case): push the farther, take the nearer; at
+                    // equal entries the later slot, as the ordering below would.
+                    const int other = std::countr_zero(mask);
+                    if (t_enter[other] <= t_enter[nearest]) {
+                        *top++ = WideEntry{first, count, t_enter[nearest]};
+                        first = node.first[other];
+                        count = node.count[other];
+                    } else {
+                        *top++ = WideEntry{node.first[other], node.count[other], t_enter[other]};
+                    }
+                    prefetch(bvh, nodes, (top - 1)->first, (top - 1)->count);
+                    continue;
+                }
+                // Three or more children: push them all, then order the pushed entries so that
                 // the nearest is on top, and take it. Those left waiting are fetched while the
                 // nearest one is traversed.
                 WideEntry* pushed = top;
@@ -616,18 +765,28 @@ struct BvhTraversal {
     }
 
     /// A ray as the leaves test it: the set's prepared ray and, for block leaves, its SIMD
-    /// form, made once per query.
+    /// forms, made once per query; kWide adds the 8-lane form of the AVX2 query.
     struct NoBlockRay {
-        explicit NoBlockRay(const typename Set::PreparedRay&) {}
+        template <class Any>
+        explicit NoBlockRay(const Any&) {}
     };
     using LeafBlockRay = std::conditional_t<kBlockSet, BlockRay, NoBlockRay>;
-    struct LeafRay {
+#if CSGRT_BVH_AVX2
+    using WideBlockRay = std::conditional_t<kBlockSet, Avx2BlockRay, NoBlockRay>;
+#else
+    using WideBlockRay = NoBlockRay;
+#endif
+    template <bool kWide>
+    struct LeafRayOf {
+        static constexpr bool kPairs = kWide && kBlockSet && CSGRT_BVH_AVX2;
         typename Set::PreparedRay prepared;
         LeafBlockRay block;
+        [[no_unique_address]] std::conditional_t<kWide, WideBlockRay, NoBlockRay> wide;
 
-        LeafRay(const Set& set, const Ray& ray, QueryScratch& scratch)
-            : prepared(set.prepare(ray, scratch)), block(prepared) {}
+        LeafRayOf(const Set& set, const Ray& ray, QueryScratch& scratch)
+            : prepared(set.prepare(ray, scratch)), block(prepared), wide(block) {}
     };
+    using LeafRay = LeafRayOf<false>;
 
     /// A triangle of a block that the set's test reports as hit on the ray's line, at t with
     /// the barycentrics b1, b2 of corners 1 and 2.
@@ -656,30 +815,62 @@ struct BvhTraversal {
     /// (the set's intersect: the hit in [t_min, record.t] that beats record under the tie
     /// rule) and occludes() (the set's occluded). Block leaves test four triangles at once and
     /// hand on only those hit on the ray's line; index leaves hand on every primitive.
-    template <bool kCount, class Visit>
-    static bool for_each_hit(const Tree& bvh, const LeafRay& ray, std::uint32_t first,
+    template <bool kCount, bool kWide, class Visit>
+    static bool for_each_hit(const Tree& bvh, const LeafRayOf<kWide>& ray, std::uint32_t first,
                              std::uint32_t count, TraversalCounters& counters, Visit&& visit) {
         if constexpr (kBlockSet) {
             if (!bvh.blocks_.empty()) {
+                // The candidate lanes of one block, finished by BlockHits (or by the set's
+                // test where an edge function is zero) and handed to visit.
+                auto visit_block = [&](const BvhTriangleBlock& block, const ShearedBlock& sheared,
+                                       unsigned candidates, unsigned zeros) {
+                    const BlockHits hits(sheared, ray.prepared.shear_z);
+                    do {
+                        const int lane = std::countr_zero(candidates);
+                        candidates &= candidates - 1;
+                        double t = hits.t[lane], b1 = hits.b1[lane], b2 = hits.b2[lane];
+                        if ((zeros >> lane & 1u) != 0 &&
+                            !TriangleSet<float>::hit_sheared(sheared.lane(lane),
+                                                             ray.prepared.shear_z, t, b1, b2)) {
+                            continue;
+                        }
+                        if (visit(BlockCandidate{block.primitive[lane], t, b1, b2, ray.prepared}))
+                            return true;
+                    } while (candidates != 0);
+                    return false;
+                };
                 const BvhTriangleBlock* block = bvh.blocks_.data() + first;
-                for (std::uint32_t left = count; left != 0; ++block) {
+                std::uint32_t left = count;
+                if constexpr (LeafRayOf<kWide>::kPairs) {
+                    for (; left > kBlockLanes; block += 2) {
+                        const std::uint32_t lanes = std::min(left, 2 * kBlockLanes);
+                        left -= lanes;
+                        if constexpr (kCount) counters.primitives_tested += lanes;
+                        ShearedBlock sheared[2];
+                        unsigned zeros;
+                        const unsigned candidates =
+                            ray.wide.candidates(block[0], block[1], sheared, zeros) &
+                            ((1u << lanes) - 1u);
+                        if ((candidates & 0xfu) != 0 &&
+                            visit_block(block[0], sheared[0], candidates & 0xfu, zeros & 0xfu)) {
+                            return true;
+                        }
+                        if ((candidates >> 4) != 0 &&
+                            visit_block(block[1], sheared[1], candidates >> 4, zeros >> 4)) {
+                            return true;
+                        }
+                    }
+                }
+                for (; left != 0; ++block) {
                     const std::uint32_t lanes = std::min(left, kBlockLanes);
                     left -= lanes;
                     if constexpr (kCount) counters.primitives_tested += lanes;
                     ShearedBlock sheared;
-                    unsigned candidates =
-                        ray.block.candidates(*block, sheared) & ((1u << lanes) - 1u);
-                    while (candidates != 0) {
-                        const int lane = std::countr_zero(candidates);
-                        candidates &= candidates - 1;
-                        double t, b1, b2;
-                        if (TriangleSet<float>::hit_sheared(sheared.lane(lane),
-                                                            ray.prepared.shear_z, t, b1, b2) &&
-                            visit(BlockCandidate{block->primitive[lane], t, b1, b2,
-                                                 ray.prepared})) {
-                            return true;
-                        }
-                    }
+                    unsigned zeros;
+                    const unsigned candidates =
+                        ray.block.candidates(*block, sheared, zeros) & ((1u << lanes) - 1u);
+                    if (candidates != 0 && visit_block(*block, sheared, candidates, zeros))
+                        return true;
                 }
                 return false;
             }
@@ -698,8 +889,8 @@ struct BvhTraversal {
     }
 
     /// The nearest-hit leaf test: keeps the leaf's best hit in `best` and lowers t_max to it.
-    template <bool kCount>
-    static bool nearest_in_leaf(const Tree& bvh, const LeafRay& ray, std::uint32_t first,
+    template <bool kCount, bool kWide>
+    static bool nearest_in_leaf(const Tree& bvh, const LeafRayOf<kWide>& ray, std::uint32_t first,
                                 std::uint32_t count, HitRecord& best, float& t_max,
                                 TraversalCounters& counters) {
         bool hit = false;
@@ -712,14 +903,14 @@ struct BvhTraversal {
     }
 
     /// The occlusion leaf test: whether any primitive of the leaf is hit in [t_min, t_max].
-    template <bool kCount>
-    static bool occluded_in_leaf(const Tree& bvh, const LeafRay& ray, std::uint32_t first,
+    template <bool kCount, bool kWide>
+    static bool occluded_in_leaf(const Tree& bvh, const LeafRayOf<kWide>& ray, std::uint32_t first,
                                  std::uint32_t count, TraversalCounters& counters) {
         return for_each_hit<kCount>(bvh, ray, first, count, counters,
                                     [](const auto& candidate) { return candidate.occludes(); });
     }
 
-    template <bool kCount>
+    template <bool kCount, bool kAvx2>
     static bool intersect(const Tree& bvh, const Ray& ray, HitRecord& record, QueryScratch& scratch,
                           TraversalCounters& counters) {
         if (bvh.set_ == nullptr) return false;
@@ -727,22 +918,27 @@ struct BvhTraversal {
         if (!box_ray.valid) return false;
         // The leaf ray is made at the first leaf: most camera rays reach none (they miss the
         // mesh's boxes), and for them the set's prepare and the block ray are pure cost.
-        std::optional<LeafRay> leaf_ray;
+        // Raw storage rather than std::optional: LeafRay is trivially destructible, so nothing
+        // is left to check or destroy on the way out.
+        using LeafRay = LeafRayOf<kAvx2>;
+        static_assert(std::is_trivially_destructible_v<LeafRay>);
+        alignas(LeafRay) unsigned char leaf_ray_storage[sizeof(LeafRay)];
+        const LeafRay* leaf_ray = nullptr;
         HitRecord best;
         best.t = ray.t_max;
         bool found = false;
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
-            if (!leaf_ray) [[unlikely]]
-                leaf_ray.emplace(*bvh.set_, ray, scratch);
+            if (leaf_ray == nullptr) [[unlikely]]
+                leaf_ray = new (leaf_ray_storage) LeafRay(*bvh.set_, ray, scratch);
             found |= nearest_in_leaf<kCount>(bvh, *leaf_ray, first, count, best, t_max, counters);
             return false;
         };
-        traverse<kCount>(bvh, ray, box_ray, counters, leaf);
+        traverse<kCount, kAvx2>(bvh, ray, box_ray, counters, leaf);
         if (found) record = best;
         return found;
     }
 
-    template <bool kCount>
+    template <bool kCount, bool kAvx2>
     static bool occluded(const Tree& bvh, const Ray& ray, QueryScratch& scratch,
                          TraversalCounters& counters) {
         if (bvh.set_ == nullptr) return false;
@@ -750,21 +946,22 @@ struct BvhTraversal {
         if (!box_ray.valid) return false;
         // Made up front, unlike intersect's: shadow rays start on a surface and nearly all
         // reach a leaf, and the deferred form cost them 58 instructions a ray (callgrind).
-        const LeafRay leaf_ray(*bvh.set_, ray, scratch);
+        const LeafRayOf<kAvx2> leaf_ray(*bvh.set_, ray, scratch);
         bool occluded = false;
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
             return occluded = occluded_in_leaf<kCount>(bvh, leaf_ray, first, count, counters);
         };
-        traverse<kCount>(bvh, ray, box_ray, counters, leaf);
+        traverse<kCount, kAvx2>(bvh, ray, box_ray, counters, leaf);
         return occluded;
     }
 
+    template <bool kAvx2>
     static void all_hits(const Tree& bvh, const Ray& ray, std::vector<HitRecord>& hits,
                          QueryScratch& scratch) {
         if (bvh.set_ == nullptr) return;
         const BoxRay box_ray(ray);
         if (!box_ray.valid) return;
-        const LeafRay leaf_ray(*bvh.set_, ray, scratch);
+        const LeafRayOf<kAvx2> leaf_ray(*bvh.set_, ray, scratch);
         TraversalCounters unused;
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
             return for_each_hit<false>(bvh, leaf_ray, first, count, unused,
@@ -776,7 +973,7 @@ struct BvhTraversal {
                                            return false;
                                        });
         };
-        traverse<false>(bvh, ray, box_ray, unused, leaf);
+        traverse<false, kAvx2>(bvh, ray, box_ray, unused, leaf);
     }
 
     /// One ray of a packet: its node test, its leaf ray and the float upper bound of its
@@ -1092,15 +1289,11 @@ template <QueryKind kKind, bool kCounted>
 bool Bvh<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
                      TraversalCounters& counters) const {
     using Traversal = detail::BvhTraversal<Set>;
-    if constexpr (kKind == QueryKind::kNearest) {
-        return Traversal::template intersect<kCounted>(*this, ray, answer, scratch, counters);
-    } else if constexpr (kKind == QueryKind::kAny) {
-        return Traversal::template occluded<kCounted>(*this, ray, scratch, counters);
-    } else {
-        const std::size_t before = answer.size();
-        Traversal::all_hits(*this, ray, answer, scratch);
-        return answer.size() > before;
-    }
+#if CSGRT_BVH_AVX2
+    if (use_avx2_)
+        return Traversal::template run_avx2<kKind, kCounted>(*this, ray, answer, scratch, counters);
+#endif
+    return Traversal::template run<kKind, kCounted, false>(*this, ray, answer, scratch, counters);
 }
 
 template <class Set>

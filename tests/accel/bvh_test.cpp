@@ -488,6 +488,9 @@ TEST(Bvh, Avx2AndSseTraversalsDoTheSameWorkRayByRay) {
     // The AVX2 node test does the SSE test's float operations in one 8-lane step, so both
     // enter the same children at the same distances: equal answers and equal counters, ray
     // by ray. (On a CPU without AVX2 both run the SSE code and the test proves nothing.)
+    // One difference is by design: the AVX2 leaf tests two triangle blocks in one step, so
+    // an occlusion query that the SSE leaf stops after a leaf's first block has tested the
+    // second block's triangles too (at most 4 more; nearest-hit queries test every block).
     const TestMesh mesh = test::sphere_mesh(5);
     const TriangleSet<float> set(mesh.vertices, mesh.triangles);
     Bvh<TriangleSet<float>> avx2, sse;
@@ -508,7 +511,8 @@ TEST(Bvh, Avx2AndSseTraversalsDoTheSameWorkRayByRay) {
         TraversalCounters c, d;
         ASSERT_EQ(avx2.occluded_counted(ray, scratch, c), sse.occluded_counted(ray, scratch, d));
         ASSERT_EQ(c.nodes_visited, d.nodes_visited) << describe(ray);
-        ASSERT_EQ(c.primitives_tested, d.primitives_tested) << describe(ray);
+        ASSERT_GE(c.primitives_tested, d.primitives_tested) << describe(ray);
+        ASSERT_LE(c.primitives_tested, d.primitives_tested + 4) << describe(ray);
     }
 }
 

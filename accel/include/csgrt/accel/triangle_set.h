@@ -67,7 +67,9 @@ public:
     /// false for a miss. A SIMD test of several triangles (the BVH's leaves) shears them with
     /// the same float operations lane by lane and calls this for every lane it keeps; it may
     /// drop a lane early only when that lane's three edge functions (computed as below) are
-    /// non-zero and of mixed signs. Its answers are then the very bits of `intersect`'s.
+    /// non-zero and of mixed signs (or one is NaN: t is then NaN, which no query keeps), and it
+    /// may finish the other lanes itself where no edge function is zero, with the double
+    /// arithmetic below in the same order. Its answers are then the very bits of `intersect`'s.
     static bool hit_sheared(const ShearedTriangle& triangle, double shear_z, double& t, double& b1,
                             double& b2);
     /// Writes the hit of triangle `index` at t into `record` when it lies in [t_min, record.t]
