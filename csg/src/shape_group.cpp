@@ -1,11 +1,91 @@
 #include "csgrt/csg/shape_group.h"
 
+#include <algorithm>
+#include <array>
+#include <functional>
 #include <utility>
 
 #include "csgrt/accel/factory.h"
 #include "csgrt/core/error.h"
+#include "csgrt/core/instance.h"
 
 namespace csgrt {
+
+namespace {
+
+/// Where a member is: the shape under an Instance (or the member itself) and the instance's
+/// matrix (zeros for a bare shape, which no Instance can have: its linear part is invertible).
+struct Placement {
+    const Shape* shape = nullptr;
+    std::array<double, 12> matrix{};
+
+    bool operator==(const Placement&) const = default;
+};
+
+/// A hash of the shape and the translation: equal placements hash alike; the linear part is
+/// left to the comparison (copies of one shape differ in their translation).
+std::size_t hash_of(const Placement& placement) {
+    std::size_t hash = std::hash<const Shape*>()(placement.shape);
+    for (std::size_t k = 9; k < 12; ++k) {
+        // boost::hash_combine's mixing step.
+        hash ^= std::hash<double>()(placement.matrix[k]) + 0x9e3779b97f4a7c15ull + (hash << 6) +
+                (hash >> 2);
+    }
+    return hash;
+}
+
+Placement placement_of(const Shape* member) {
+    Placement placement;
+    const auto* instance = dynamic_cast<const Instance*>(member);
+    if (instance == nullptr) {
+        placement.shape = member;
+        return placement;
+    }
+    placement.shape = &instance->shape();
+    const Transform& transform = instance->world_from_object();
+    for (int row = 0; row < 3; ++row) {
+        for (int column = 0; column < 3; ++column) {
+            // + 0.0 turns -0 into +0, so equal entries hash alike.
+            placement.matrix[static_cast<std::size_t>(3 * row + column)] =
+                transform.linear()(row, column) + 0.0;
+        }
+        placement.matrix[static_cast<std::size_t>(9 + row)] = transform.translation()[row] + 0.0;
+    }
+    return placement;
+}
+
+}  // namespace
+
+std::vector<bool> exact_repeats(std::span<const Shape* const> members) {
+    // Sorted by hash, then placement, then index: equal placements end up side by side with
+    // the first of them leading, in O(n log n) whatever the input (a hash set would allocate
+    // per member, and runs of equal hashes would compare in pairs).
+    struct Keyed {
+        std::size_t hash;
+        Placement placement;
+        std::size_t index;
+    };
+    std::vector<Keyed> keyed;
+    keyed.reserve(members.size());
+    for (std::size_t i = 0; i < members.size(); ++i) {
+        if (members[i] == nullptr) continue;
+        const Placement placement = placement_of(members[i]);
+        keyed.push_back({hash_of(placement), placement, i});
+    }
+    std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+        if (a.hash != b.hash) return a.hash < b.hash;
+        if (a.placement.shape != b.placement.shape)
+            return std::less<const Shape*>()(a.placement.shape, b.placement.shape);
+        if (a.placement.matrix != b.placement.matrix)
+            return a.placement.matrix < b.placement.matrix;
+        return a.index < b.index;
+    });
+    std::vector<bool> repeats(members.size(), false);
+    for (std::size_t k = 1; k < keyed.size(); ++k) {
+        repeats[keyed[k].index] = keyed[k].placement == keyed[k - 1].placement;
+    }
+    return repeats;
+}
 
 ShapeGroup::ShapeGroup(std::span<const std::shared_ptr<const Shape>> members,
                        std::string_view accelerator, const AcceleratorConfig& config,
@@ -13,12 +93,17 @@ ShapeGroup::ShapeGroup(std::span<const std::shared_ptr<const Shape>> members,
     require(members.size() < kNoIndex, "ShapeGroup", "member count", "below 2^32 - 1",
             members.size());
     std::vector<std::shared_ptr<const Shape>> bounded;
+    std::vector<const Shape*> pointers(members.size());
     for (std::size_t i = 0; i < members.size(); ++i) {
         // Tested before the message is built: a scene commits tens of thousands of members.
         if (members[i] == nullptr)
             require(false, "ShapeGroup", "member " + std::to_string(i), "a shape", "null");
+        pointers[i] = members[i].get();
+    }
+    const std::vector<bool> repeats = exact_repeats(pointers);
+    for (std::size_t i = 0; i < members.size(); ++i) {
         const Aabb box = members[i]->bounds();
-        if (box.is_empty()) continue;
+        if (box.is_empty() || repeats[i]) continue;
         if (box.is_finite()) {
             bounded.push_back(members[i]);
             set_member_.push_back(static_cast<std::uint32_t>(i));

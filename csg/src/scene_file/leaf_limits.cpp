@@ -42,7 +42,8 @@ namespace {
 /// the loader to report. Pointers are assembled from the stack of tokens only for a message.
 class LeafPrescan {
 public:
-    LeafPrescan(const Json& root, const Source& source) : root_(root), source_(source) {
+    LeafPrescan(const Json& root, const DefinitionIndex& index, const Source& source)
+        : root_(root), index_(index), source_(source) {
         if (const auto found = root.find("definitions");
             found != root.end() && found->is_object()) {
             definitions_ = &*found;
@@ -100,13 +101,14 @@ private:
             leaves = grid(value, depth);
         } else if (name == "ref") {
             const auto target = value.find("definition");
-            if (definitions_ != nullptr && target != value.end() && target->is_string()) {
-                const auto body = definitions_->find(target->get_ref<const std::string&>());
-                if (body != definitions_->end()) {
+            if (target != value.end() && target->is_string()) {
+                const auto body = index_.find(target->get_ref<const std::string&>());
+                if (body != index_.end()) {
                     // The definition's own tokens replace this node's in a message.
                     std::vector<std::string> saved = std::move(tokens_);
                     tokens_ = {"definitions"};
-                    leaves = definition(target->get_ref<const std::string&>(), *body, depth);
+                    leaves =
+                        definition(target->get_ref<const std::string&>(), *body->second, depth);
                     tokens_ = std::move(saved);
                 }
             }
@@ -184,6 +186,7 @@ private:
     }
 
     const Json& root_;
+    const DefinitionIndex& index_;
     const Source& source_;
     const Json* definitions_ = nullptr;
     std::unordered_map<std::string, std::uint64_t> counted_;
@@ -193,8 +196,8 @@ private:
 
 }  // namespace
 
-void prescan_leaves(const Json& root, const Source& source) {
-    LeafPrescan(root, source).run();
+void prescan_leaves(const Json& root, const DefinitionIndex& definitions, const Source& source) {
+    LeafPrescan(root, definitions, source).run();
 }
 
 }  // namespace csgrt::detail::scene_file

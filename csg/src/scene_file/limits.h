@@ -21,6 +21,9 @@ constexpr std::size_t kMaxShapeDepth = 256;
 /// shared definitions and nested grids describe 2^64 leaves in 5 KB, and a ray may have to
 /// visit every one of them.
 constexpr std::uint64_t kMaxExpandedLeaves = 10'000'000;
+/// Leaf shapes overlapping at one point (overlapping_leaves): a ray there tests each of them,
+/// whatever the structure, so a pile of 2^20 copies a nanometre apart never finishes a render.
+constexpr std::uint64_t kMaxOverlappingLeaves = 10'000;
 /// The file is parsed into memory whole; its tree takes about ten times its size.
 constexpr std::uintmax_t kMaxSceneFileBytes = 256u << 20;
 /// Keys and names longer than this are cut in messages.

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "csgrt/core/error.h"
 #include "csgrt/csg/compound.h"
 #include "limits.h"
 #include "loader.h"
@@ -32,6 +33,10 @@ ShapePointer Loader::shape(Fields& fields) {
         built = entry->build(fields, *this);
     } catch (const InvalidParameter& error) {
         rethrow_invalid(error, fields, fields.value(), entry->angles);
+    }
+    if (const std::uint64_t overlap = overlapping_leaves(*built, overlaps_);
+        overlap > kMaxOverlappingLeaves) {
+        fields.fail("", overlap_message(overlap));
     }
     if (fields.has("transform")) {
         const bool bounded = built->bounds().is_finite();
@@ -101,6 +106,19 @@ std::vector<ShapePointer> Loader::grid(Fields& fields) {
                                  std::to_string(item_leaves) + " leaf shapes are more than the " +
                                  std::to_string(kMaxExpandedLeaves) +
                                  " leaves a scene may expand to (docs/scene-format.md, Limits)");
+    }
+    // Refused before the copies are made too: copies piled closer than their size.
+    const std::uint64_t piled = grid_overlap(counts, spacing, item->bounds());
+    if (const std::uint64_t overlap = piled * overlapping_leaves(*item, overlaps_);
+        overlap > kMaxOverlappingLeaves) {
+        std::string message = std::to_string(piled);
+        message.append(" copies meet at one point (\"spacing\" ")
+            .append(detail::describe(spacing))
+            .append(" against the item's size ")
+            .append(detail::describe(Vector3(item->bounds().diagonal())))
+            .append("): ")
+            .append(overlap_message(overlap));
+        fields.fail("count", message);
     }
     Transform placement;
     if (fields.has("transform")) {
@@ -175,15 +193,20 @@ Scene Loader::load() {
     materials(scene, material_index);
     lights(scene);
     ambient_and_background(scene);
-    prescan_leaves(root_, source_);
     if (top.has("definitions")) {
         definitions_ = &root_.at("definitions");
+        if (definitions_->is_object()) {
+            definition_index_.reserve(definitions_->size());
+            for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
+                definition_index_.emplace(it.key(), &it.value());
+            }
+        }
+    }
+    prescan_leaves(root_, definition_index_, source_);
+    if (definitions_ != nullptr) {
         if (!definitions_->is_object()) {
             source_.fail("/definitions",
                          "expected an object of named shapes, got " + describe(*definitions_));
-        }
-        for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
-            definition_index_.emplace(it.key(), &it.value());
         }
         // Every definition is built, used or not, so its errors are reported.
         for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
@@ -209,6 +232,8 @@ Scene Loader::load() {
         }
         return found->second;
     };
+    // The file's object each scene object came from (a grid gives several).
+    std::vector<std::size_t> object_of;
     for (std::size_t i = 0; i < objects.size(); ++i) {
         Fields fields(objects[i], child_pointer("/objects", i), source_, "a scene object");
         const std::string name = fields.string("name", "");
@@ -239,12 +264,23 @@ Scene Loader::load() {
                 scene.add_object(copies[c], palette[c % palette.size()],
                                  name.empty() ? name : name + "[" + std::to_string(c) + "]");
             }
+            object_of.insert(object_of.end(), copies.size(), i);
         } else {
             ShapePointer built = shape(fields);
             fields.finish();
             count_leaves(*built, fields.pointer());
             scene.add_object(std::move(built), palette.front(), name);
+            object_of.push_back(i);
         }
+    }
+    // The objects share the scene's structure: a pile of them is one pile.
+    std::vector<const Shape*> shapes;
+    shapes.reserve(scene.objects().size());
+    for (const SceneObject& object : scene.objects()) shapes.push_back(object.shape.get());
+    if (const Overlap overlap = overlapping_leaves(shapes, true, overlaps_);
+        overlap.leaves > kMaxOverlappingLeaves) {
+        source_.fail(child_pointer("/objects", object_of[overlap.member]),
+                     "with the objects around it, " + overlap_message(overlap.leaves));
     }
     return scene;
 }

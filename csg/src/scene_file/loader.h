@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <span>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -18,6 +19,13 @@
 namespace csgrt::detail::scene_file {
 
 class Loader;
+
+/// The definitions by name (views of the keys in the parsed tree), so a ref costs a hash
+/// look-up, not a scan of the object (ordered_json finds a key by a linear search).
+using DefinitionIndex = std::unordered_map<std::string_view, const Json*>;
+
+/// Each distinct composite shape's overlapping_leaves.
+using OverlapMemo = std::unordered_map<const Shape*, std::uint64_t>;
 
 /// One entry of the shape table: the "type" keyword and how to build it from its fields.
 /// Adding a shape to the format is one entry here.
@@ -81,14 +89,14 @@ private:
     const Json& root_;
     const Source& source_;
     const Json* definitions_ = nullptr;
-    /// The definitions by name, so a ref costs a hash look-up, not a scan of the object.
-    std::unordered_map<std::string, const Json*> definition_index_;
+    DefinitionIndex definition_index_;
     std::map<std::string, ShapePointer> built_;
     /// Shapes being built, one per nesting level (refs included), against kMaxShapeDepth.
     std::size_t depth_ = 0;
     /// Each distinct shape's count of expanded leaves, so shared subtrees are counted once.
     std::unordered_map<const Shape*, std::uint64_t> leaves_;
     std::uint64_t total_leaves_ = 0;
+    OverlapMemo overlaps_;
     std::map<std::string, ShapePointer> meshes_;
     /// Definitions being built, outermost first: a name met again here is a cycle.
     std::vector<std::string> building_;
@@ -114,8 +122,36 @@ std::uint64_t expanded_leaves(const Shape& shape,
                               std::unordered_map<const Shape*, std::uint64_t>& memo);
 
 /// Counts the expanded leaves the parsed file `root` describes before anything is built, and
-/// fails (SceneError) where they pass kMaxExpandedLeaves (leaf_limits.cpp).
-void prescan_leaves(const Json& root, const Source& source);
+/// fails (SceneError) where they pass kMaxExpandedLeaves (leaf_limits.cpp). `definitions`
+/// indexes root's "definitions" (empty when it has none or they are not an object).
+void prescan_leaves(const Json& root, const DefinitionIndex& definitions, const Source& source);
+
+/// The most leaf shapes a ray may have to test at one point of `shape`: 1 for a leaf, the
+/// shape's for an instance, the estimate below over the children of a composite
+/// (overlap_estimate.cpp). Memoised per distinct composite.
+std::uint64_t overlapping_leaves(const Shape& shape, OverlapMemo& memo);
+
+/// The largest overlap found in a list, and the member at whose box's centre it was found.
+struct Overlap {
+    std::uint64_t leaves = 0;
+    std::size_t member = 0;
+};
+
+/// An estimate for a list of members (a compound's children, a boolean's operands, the scene's
+/// objects): the largest sum of the members' overlapping_leaves over the members whose boxes
+/// hold one sample point, the sample points being the centres of up to 64 members' boxes. A
+/// member whose box encloses the sample's, or is enclosed by it, with a margin is not counted
+/// (nested shapes are met in turn, not all at once); members with an infinite box are counted
+/// at every point. Exact repeats count once when `drops_repeats` (compounds and the scene).
+Overlap overlapping_leaves(std::span<const Shape* const> members, bool drops_repeats,
+                           OverlapMemo& memo);
+
+/// The copies of a grid (`counts` along x, y, z, `spacing` apart) whose copies of a box like
+/// `item` meet at one point; copies along an axis of zero spacing are exact repeats.
+std::uint64_t grid_overlap(const std::size_t counts[3], const Vector3& spacing, const Aabb& item);
+
+/// "about N leaf shapes overlap at one point ...; at most kMaxOverlappingLeaves may".
+std::string overlap_message(std::uint64_t leaves);
 
 /// The parsed JSON tree of `text`; a SceneError for invalid JSON, a duplicate key or nesting
 /// deeper than kMaxJsonDepth (json_tree.cpp).

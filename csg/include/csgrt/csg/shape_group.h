@@ -19,9 +19,11 @@ namespace csgrt {
 /// builds at commit over its objects. The members with a finite box sit in a ShapeSet under
 /// an acceleration structure chosen through make_accelerator; members with an infinite box
 /// (planes) are kept apart and tested on every ray; members with an empty box can never be hit
-/// and are dropped. Hits carry `object` = the member's index in the list given to the
-/// constructor, and at equal t the lower member index wins, wherever the two members sit (the
-/// one tie rule of ShapeSet, extended to the unbounded members).
+/// and are dropped, and so are exact repeats of an earlier member (exact_repeats: the same
+/// shape object in the same place), which answer every ray as that member does and lose every
+/// tie to it: a pile of 2^20 coincident copies costs one test, not 2^20. Hits carry `object` = the
+/// member's index in the list given to the constructor, and at equal t the lower member index wins,
+/// wherever the two members sit (the one tie rule of ShapeSet, extended to the unbounded members).
 ///
 /// Built once, then const and thread-safe; the structure refers to the set, so a group never
 /// moves or copies (owners hold it by value or by pointer).
@@ -45,12 +47,13 @@ public:
     /// Whether any member is hit in [t_min, t_max]; stops at the first.
     bool any(const Ray& ray, QueryScratch& scratch) const;
     /// Appends each member's nearest hit in [t_min, t_max], at most one a member, in no
-    /// particular order.
+    /// particular order; an exact repeat of an earlier member gives none.
     void all(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
     /// The same for the bounded members only (through the structure).
     void all_bounded(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
 
-    /// The bounded members, in member order, and the member index of set member i.
+    /// The bounded members, in member order (exact repeats left out), and the member index of
+    /// set member i.
     const ShapeSet& bounded() const { return set_; }
     std::uint32_t member_of(std::size_t i) const { return set_member_[i]; }
     /// The members with an infinite box, by member index, in increasing order.
@@ -77,5 +80,9 @@ private:
     Aabb bounds_;
     std::string reason_;
 };
+
+/// For each of `members`, whether it repeats an earlier member exactly: the same shape object,
+/// bare or under an Instance, with a transform equal entry for entry (+0 and -0 alike).
+std::vector<bool> exact_repeats(std::span<const Shape* const> members);
 
 }  // namespace csgrt
