@@ -295,9 +295,12 @@ struct SseNodeTest {
 };
 
 #if CSGRT_BVH_AVX2
+// The AVX2 types are aligned explicitly: compiled for baseline x86-64, GCC aligns a struct of
+// __m256 members to 16 bytes only, and the AVX2 code's aligned stores to it would fault.
+
 /// SseNodeTest<8> in one 8-lane AVX step: the same operations, lane by lane, in the same order
 /// (no fused multiply-add), so the same masks and entry distances.
-struct Avx2NodeTest {
+struct alignas(32) Avx2NodeTest {
     __m256 origin[3], inverse_near[3], inverse_far[3], t_min;
     int near_row[3], far_row[3];
 
@@ -334,6 +337,104 @@ struct Avx2NodeTest {
             t0 = _mm256_sub_ps(t0, _mm256_mul_ps(_mm256_andnot_ps(sign, t0), slack));
             t1 = _mm256_add_ps(t1, _mm256_mul_ps(_mm256_andnot_ps(sign, t1), slack));
         }
+        _mm256_store_ps(t_enter, t0);
+        return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+    }
+};
+#endif
+
+#if CSGRT_BVH_AVX2
+/// The node test of a packet of rays whose directions share their signs, taken as intervals
+/// (interval arithmetic culling: Wald, Boulos and Shirley, "Ray Tracing Deformable Scenes
+/// Using Dynamic Bounding Volume Hierarchies", ACM TOG 2007). On each axis the rays' origins
+/// span [o_low, o_high] and their (slack-scaled) reciprocals [near_low, near_high] and
+/// [far_low, far_high], all of one sign. Rounding to nearest is monotone, so fl(b - o) and
+/// fl(x * inverse) move the way their exact values do, and each ray's own near distance
+/// fl(fl(b - o_r) * near_r) is at least the smaller of fl(fl(b - o) * near_low) and
+/// fl(fl(b - o) * near_high) with o the end of the origin interval that makes b - o least
+/// along the ray (o_high for a positive direction, o_low for a negative one); likewise each
+/// far distance is at most the larger of the two products from the other end. So the
+/// packet's [t_enter, t_exit] contains every ray's, and the packet enters every child that
+/// one of its rays would enter: the leaves it reaches include each ray's own. Rays that could
+/// make a slab distance NaN (a zero direction component, an unrepresentable ray) or need the
+/// signed-interval widening are not accepted, nor packets without a common origin; those go
+/// one ray at a time.
+struct alignas(32) PacketIntervalTest {
+    __m256 near_origin[3], far_origin[3], near_low[3], near_high[3], far_low[3], far_high[3];
+    __m256 t_min;
+    int near_row[3], far_row[3];
+
+    /// Whether the open rays of `lanes` (bits of `open`) can be walked as one; if so, sets the
+    /// test up.
+    template <class Lanes>
+    [[gnu::target("avx2")]] bool accepts(const Lanes& lanes, std::uint32_t open) {
+        const BoxRay& first = lanes[std::countr_zero(open)].box;
+        float o_low[3], o_high[3], n_low[3], n_high[3], f_low[3], f_high[3];
+        float lowest_t_min = kFloatInfinity;
+        for (int axis = 0; axis < 3; ++axis) {
+            o_low[axis] = n_low[axis] = f_low[axis] = kFloatInfinity;
+            o_high[axis] = n_high[axis] = f_high[axis] = -kFloatInfinity;
+        }
+        for (std::uint32_t m = open; m != 0; m &= m - 1) {
+            const BoxRay& ray = lanes[std::countr_zero(m)].box;
+            if (ray.signed_interval) return false;
+            // One origin (a pinhole camera's rays): see traverse_packet.
+            if (!(ray.origin[0] == first.origin[0] && ray.origin[1] == first.origin[1] &&
+                  ray.origin[2] == first.origin[2])) {
+                return false;
+            }
+            lowest_t_min = std::min(lowest_t_min, ray.t_min);
+            for (int axis = 0; axis < 3; ++axis) {
+                // Finite reciprocals (false for the NaN of an unrepresentable ray and for the
+                // infinity of a zero component), and one sign per axis.
+                if (!(std::abs(ray.inverse_near[axis]) <= std::numeric_limits<float>::max() &&
+                      std::abs(ray.inverse_far[axis]) <= std::numeric_limits<float>::max()) ||
+                    ray.negative[axis] != first.negative[axis]) {
+                    return false;
+                }
+                o_low[axis] = std::min(o_low[axis], ray.origin[axis]);
+                o_high[axis] = std::max(o_high[axis], ray.origin[axis]);
+                n_low[axis] = std::min(n_low[axis], ray.inverse_near[axis]);
+                n_high[axis] = std::max(n_high[axis], ray.inverse_near[axis]);
+                f_low[axis] = std::min(f_low[axis], ray.inverse_far[axis]);
+                f_high[axis] = std::max(f_high[axis], ray.inverse_far[axis]);
+            }
+        }
+        for (int axis = 0; axis < 3; ++axis) {
+            const bool negative = first.negative[axis];
+            near_origin[axis] = _mm256_set1_ps(negative ? o_low[axis] : o_high[axis]);
+            far_origin[axis] = _mm256_set1_ps(negative ? o_high[axis] : o_low[axis]);
+            near_low[axis] = _mm256_set1_ps(n_low[axis]);
+            near_high[axis] = _mm256_set1_ps(n_high[axis]);
+            far_low[axis] = _mm256_set1_ps(f_low[axis]);
+            far_high[axis] = _mm256_set1_ps(f_high[axis]);
+            near_row[axis] = first.near_row(axis, 8);
+            far_row[axis] = first.far_row(axis, 8);
+        }
+        t_min = _mm256_set1_ps(lowest_t_min);
+        return true;
+    }
+
+    /// As Avx2NodeTest::hit<false> for the whole packet; t_enter must be 32-byte aligned.
+    template <bool kSigned>
+    [[gnu::target("avx2")]] unsigned hit(const Bvh8Node& node, float t_max, float* t_enter) const {
+        static_assert(!kSigned, "packets with signed intervals are walked ray by ray");
+        const float* bounds = node.bounds[0];
+        __m256 t_near[3], t_far[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            const __m256 near_distance =
+                _mm256_sub_ps(_mm256_load_ps(bounds + near_row[axis]), near_origin[axis]);
+            const __m256 far_distance =
+                _mm256_sub_ps(_mm256_load_ps(bounds + far_row[axis]), far_origin[axis]);
+            t_near[axis] = _mm256_min_ps(_mm256_mul_ps(near_distance, near_low[axis]),
+                                         _mm256_mul_ps(near_distance, near_high[axis]));
+            t_far[axis] = _mm256_max_ps(_mm256_mul_ps(far_distance, far_low[axis]),
+                                        _mm256_mul_ps(far_distance, far_high[axis]));
+        }
+        const __m256 t0 =
+            _mm256_max_ps(_mm256_max_ps(t_near[0], t_near[1]), _mm256_max_ps(t_near[2], t_min));
+        const __m256 t1 = _mm256_min_ps(_mm256_min_ps(t_far[0], t_far[1]),
+                                        _mm256_min_ps(t_far[2], _mm256_set1_ps(t_max)));
         _mm256_store_ps(t_enter, t0);
         return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
     }
@@ -458,7 +559,7 @@ struct BlockRay {
 /// BlockRay::candidates on two consecutive blocks at once, lanes 0-3 the first and 4-7 the
 /// second, in 8-lane AVX2 steps: the same operations lane by lane (no fused multiply-add), so
 /// the same bits. Most leaves hold five to eight triangles, two blocks.
-struct Avx2BlockRay {
+struct alignas(32) Avx2BlockRay {
     __m256 origin[3], shear_x, shear_y;
     int axis[3];
 
@@ -517,6 +618,82 @@ struct Avx2BlockRay {
             split(u, sheared[0].u, sheared[1].u);
             split(v, sheared[0].v, sheared[1].v);
             split(w, sheared[0].w, sheared[1].w);
+        }
+        return result;
+    }
+};
+#endif
+
+#if CSGRT_BVH_AVX2
+/// The rays of a packet as TriangleSet<float>'s test sees them, lane r holding ray r, for
+/// packets whose rays share the test's axis permutation: each triangle of a leaf is sheared
+/// into every ray's frame at once with the float operations of TriangleSet::shear and the edge
+/// functions of hit_sheared, lane by lane, so each lane holds its ray's own values (the
+/// ray-parallel leaf test of Wald et al., "Interactive Rendering with Coherent Ray Tracing",
+/// 2001). Lanes the sign test rules out are misses for the scalar test too; the others finish
+/// with TriangleSet::hit_sheared on their own values.
+struct alignas(32) PacketTriangleRays {
+    __m256 origin[3], shear_x, shear_y;
+    int axis[3];
+
+    /// Whether the open rays' prepared rays share their axes; if so, sets the lanes up.
+    [[gnu::target("avx2")]] bool accepts(const TriangleSet<float>::PreparedRay* prepared,
+                                         std::uint32_t open) {
+        const auto& first = prepared[std::countr_zero(open)];
+        alignas(32) float values[5][8] = {};
+        for (std::uint32_t m = open; m != 0; m &= m - 1) {
+            const int r = std::countr_zero(m);
+            const auto& ray = prepared[r];
+            if (ray.axis_z != first.axis_z) return false;
+            values[0][r] = ray.origin[ray.axis_x];
+            values[1][r] = ray.origin[ray.axis_y];
+            values[2][r] = ray.origin[ray.axis_z];
+            values[3][r] = ray.shear_x;
+            values[4][r] = ray.shear_y;
+        }
+        axis[0] = first.axis_x;
+        axis[1] = first.axis_y;
+        axis[2] = first.axis_z;
+        for (int a = 0; a < 3; ++a) origin[a] = _mm256_load_ps(values[a]);
+        shear_x = _mm256_load_ps(values[3]);
+        shear_y = _mm256_load_ps(values[4]);
+        return true;
+    }
+
+    /// The rays (bits of `rays`) for which triangle `lane` of `block` may be hit; where there
+    /// are some, `sheared` holds every ray's sheared corners (x, y, z of corners 0, 1, 2).
+    [[gnu::target("avx2")]] unsigned candidates(const BvhTriangleBlock& block, int lane,
+                                                unsigned rays, float (&sheared)[9][8]) const {
+        __m256 x[3], y[3], z[3];
+        for (int k = 0; k < 3; ++k) {
+            const __m256 px =
+                _mm256_sub_ps(_mm256_set1_ps(block.corners[k][axis[0]][lane]), origin[0]);
+            const __m256 py =
+                _mm256_sub_ps(_mm256_set1_ps(block.corners[k][axis[1]][lane]), origin[1]);
+            const __m256 pz =
+                _mm256_sub_ps(_mm256_set1_ps(block.corners[k][axis[2]][lane]), origin[2]);
+            x[k] = _mm256_sub_ps(px, _mm256_mul_ps(shear_x, pz));
+            y[k] = _mm256_sub_ps(py, _mm256_mul_ps(shear_y, pz));
+            z[k] = pz;
+        }
+        const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
+        const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
+        const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
+        const __m256 zero = _mm256_setzero_ps();
+        const unsigned zeros = static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(
+            _mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
+            _mm256_cmp_ps(w, zero, _CMP_EQ_OQ))));
+        const unsigned some_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(u, v), w)));
+        const unsigned all_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(u, v), w)));
+        const unsigned result = (zeros | ~(some_negative & ~all_negative)) & rays;
+        if (result != 0) {
+            for (int k = 0; k < 3; ++k) {
+                _mm256_store_ps(sheared[k], x[k]);
+                _mm256_store_ps(sheared[3 + k], y[k]);
+                _mm256_store_ps(sheared[6 + k], z[k]);
+            }
         }
         return result;
     }
@@ -686,10 +863,17 @@ struct BvhTraversal {
     static void traverse_wide(const Tree& bvh, const WideBvhNodes<kWidth>& nodes,
                               const BoxRay& box_ray, double ray_t_max, TraversalCounters& counters,
                               Leaf& leaf) {
-        using Node = WideBvhNode<kWidth>;
         if (nodes.empty()) return;
         const NodeTest test(box_ray);
-        float t_max = round_up(ray_t_max);
+        walk_wide<kCount, kSigned>(bvh, nodes, test, round_up(ray_t_max), counters, leaf);
+    }
+
+    /// traverse_wide with its node test made: `test.hit<kSigned>(node, t_max, t_enter)` gives
+    /// the mask of the children to enter (a single ray's, or a packet's conservative one).
+    template <bool kCount, bool kSigned, class NodeTest, int kWidth, class Leaf>
+    static void walk_wide(const Tree& bvh, const WideBvhNodes<kWidth>& nodes, const NodeTest& test,
+                          float t_max, TraversalCounters& counters, Leaf& leaf) {
+        using Node = WideBvhNode<kWidth>;
 
         // Each level pushes at most kWidth - 1 children.
         WideEntry stack[(kWidth - 1) * kMaxDepth + 1];
@@ -976,17 +1160,49 @@ struct BvhTraversal {
         traverse<false, kAvx2>(bvh, ray, box_ray, unused, leaf);
     }
 
-    /// One ray of a packet: its node test, its leaf ray and the float upper bound of its
-    /// interval, as the single-ray traversal keeps them.
+#if CSGRT_BVH_AVX2
     template <class NodeTest>
-    struct PacketLane {
-        BoxRay box;
-        NodeTest test;
-        LeafRay leaf;
-        float t_max;
+    static constexpr bool kAvx2Test = std::is_same_v<NodeTest, Avx2NodeTest>;
+#else
+    template <class NodeTest>
+    static constexpr bool kAvx2Test = false;
+#endif
 
-        PacketLane(const Set& set, const Ray& ray, QueryScratch& scratch)
-            : box(ray), test(box), leaf(set, ray, scratch), t_max(round_up(ray.t_max)) {}
+    /// The rays of a packet: each one's box ray and float upper bound, and, made when first
+    /// needed, its node test (the ray-by-ray walk only) and its leaf ray (at its first leaf:
+    /// most camera rays reach none).
+    template <class NodeTest>
+    struct PacketLanes {
+        using LeafRayType = LeafRayOf<kAvx2Test<NodeTest>>;
+        struct Lane {
+            BoxRay box;
+            float t_max;
+        };
+        static_assert(std::is_trivially_destructible_v<Lane> &&
+                      std::is_trivially_destructible_v<NodeTest> &&
+                      std::is_trivially_destructible_v<LeafRayType>);
+        alignas(Lane) unsigned char lane_storage[sizeof(Lane) * Tree::kPacketRays];
+        alignas(NodeTest) unsigned char test_storage[sizeof(NodeTest) * Tree::kPacketRays];
+        alignas(LeafRayType) unsigned char leaf_storage[sizeof(LeafRayType) * Tree::kPacketRays];
+        std::uint32_t leaf_made = 0;
+
+        Lane& operator[](int r) { return reinterpret_cast<Lane*>(lane_storage)[r]; }
+        const Lane& operator[](int r) const {
+            return reinterpret_cast<const Lane*>(lane_storage)[r];
+        }
+        void make(int r, const Ray& ray) {
+            new (&(*this)[r]) Lane{BoxRay(ray), round_up(ray.t_max)};
+        }
+        NodeTest& test(int r) { return reinterpret_cast<NodeTest*>(test_storage)[r]; }
+        void make_test(int r) { new (&test(r)) NodeTest((*this)[r].box); }
+        const LeafRayType& leaf(int r, const Set& set, const Ray& ray, QueryScratch& scratch) {
+            LeafRayType* leaves = reinterpret_cast<LeafRayType*>(leaf_storage);
+            if ((leaf_made >> r & 1u) == 0) {
+                new (&leaves[r]) LeafRayType(set, ray, scratch);
+                leaf_made |= 1u << r;
+            }
+            return leaves[r];
+        }
     };
     struct PacketEntry {
         std::uint32_t first;
@@ -1010,20 +1226,42 @@ struct BvhTraversal {
                                 std::span<const Ray> rays, HitRecord* best, bool* found,
                                 QueryScratch& scratch) {
         using Node = WideBvhNode<kWidth>;
-        using Lane = PacketLane<NodeTest>;
         const int n = static_cast<int>(rays.size());
         for (int r = 0; r < n; ++r) found[r] = false;
         if (nodes.empty()) return;
-        alignas(Lane) unsigned char storage[sizeof(Lane) * Tree::kPacketRays];
-        Lane* lanes = reinterpret_cast<Lane*>(storage);
+        PacketLanes<NodeTest> lanes;
         std::uint32_t open = 0;
         for (int r = 0; r < n; ++r) {
-            if (!is_valid(rays[r])) continue;
-            new (&lanes[r]) Lane(*bvh.set_, rays[r], scratch);
+            lanes.make(r, rays[r]);
+            if (!lanes[r].box.valid) continue;
             best[r] = HitRecord{};
             best[r].t = rays[r].t_max;
             open |= 1u << r;
         }
+        if (open == 0) return;
+#if CSGRT_BVH_AVX2
+        if constexpr (kAvx2Test<NodeTest>) {
+            PacketIntervalTest interval;
+            if (interval.accepts(lanes, open)) {
+                return walk_interval_packet<kAny>(bvh, rays, lanes, open, interval, best, found,
+                                                  scratch);
+            }
+            // Rays without a common origin (shadow rays from a surface, incoherent rays): the
+            // packet's interval would hold the region between their origins, where each of
+            // them tests every leaf near any of them; one at a time is faster.
+            TraversalCounters unused;
+            for (std::uint32_t m = open; m != 0; m &= m - 1) {
+                const int r = std::countr_zero(m);
+                if constexpr (kAny) {
+                    found[r] = occluded<false, true>(bvh, rays[r], scratch, unused);
+                } else {
+                    found[r] = intersect<false, true>(bvh, rays[r], best[r], scratch, unused);
+                }
+            }
+            return;
+        }
+#endif
+        for (std::uint32_t m = open; m != 0; m &= m - 1) lanes.make_test(std::countr_zero(m));
         TraversalCounters unused;
 
         PacketEntry stack[(kWidth - 1) * kMaxDepth + 1];
@@ -1038,12 +1276,12 @@ struct BvhTraversal {
                 unsigned entered = 0;
                 for (std::uint32_t m = active; m != 0; m &= m - 1) {
                     const int r = std::countr_zero(m);
-                    Lane& lane = lanes[r];
+                    const auto& lane = lanes[r];
+                    const NodeTest& test = lanes.test(r);
                     alignas(32) float t_enter[kWidth];
-                    const unsigned mask =
-                        lane.box.signed_interval
-                            ? lane.test.template hit<true>(node, lane.t_max, t_enter)
-                            : lane.test.template hit<false>(node, lane.t_max, t_enter);
+                    const unsigned mask = lane.box.signed_interval
+                                              ? test.template hit<true>(node, lane.t_max, t_enter)
+                                              : test.template hit<false>(node, lane.t_max, t_enter);
                     for (unsigned c = mask; c != 0; c &= c - 1) {
                         const int slot = std::countr_zero(c);
                         child_enter[slot] = std::min(child_enter[slot], t_enter[slot]);
@@ -1073,14 +1311,15 @@ struct BvhTraversal {
             if (count != Node::kInterior && count != 0) {
                 for (std::uint32_t m = active; m != 0; m &= m - 1) {
                     const int r = std::countr_zero(m);
-                    Lane& lane = lanes[r];
+                    auto& lane = lanes[r];
+                    const auto& leaf_ray = lanes.leaf(r, *bvh.set_, rays[r], scratch);
                     if constexpr (kAny) {
-                        if (occluded_in_leaf<false>(bvh, lane.leaf, first, count, unused)) {
+                        if (occluded_in_leaf<false>(bvh, leaf_ray, first, count, unused)) {
                             found[r] = true;
                             open &= ~(1u << r);
                         }
                     } else {
-                        found[r] |= nearest_in_leaf<false>(bvh, lane.leaf, first, count, best[r],
+                        found[r] |= nearest_in_leaf<false>(bvh, leaf_ray, first, count, best[r],
                                                            lane.t_max, unused);
                     }
                 }
@@ -1109,6 +1348,99 @@ struct BvhTraversal {
         const Tree& bvh, std::span<const Ray> rays, HitRecord* best, bool* found,
         QueryScratch& scratch) {
         traverse_packet<kAny, Avx2NodeTest>(bvh, bvh.nodes_8_, rays, best, found, scratch);
+    }
+#endif
+
+#if CSGRT_BVH_AVX2
+    /// The nearest hits (or occlusion) of a packet whose rays PacketIntervalTest accepts: the
+    /// tree is walked once with the packet's conservative node test, as one ray would walk it,
+    /// and every leaf it reaches is tested for each open ray with that ray's own leaf test and
+    /// t_max. The upper bound of the walk is the largest t_max of the open rays.
+    template <bool kAny>
+    [[gnu::target("avx2")]] static void walk_interval_packet(
+        const Tree& bvh, std::span<const Ray> rays, PacketLanes<Avx2NodeTest>& lanes,
+        std::uint32_t open, const PacketIntervalTest& test, HitRecord* best, bool* found,
+        QueryScratch& scratch) {
+        TraversalCounters unused;
+        auto largest_t_max = [&] {
+            float t_max = -kFloatInfinity;
+            for (std::uint32_t m = open; m != 0; m &= m - 1)
+                t_max = std::max(t_max, lanes[std::countr_zero(m)].t_max);
+            return t_max;
+        };
+        if constexpr (kBlockSet) {
+            if (!bvh.blocks_.empty()) {
+                // Ray-parallel leaves, when the rays share the triangle test's axes.
+                typename Set::PreparedRay prepared[Tree::kPacketRays];
+                for (std::uint32_t m = open; m != 0; m &= m - 1) {
+                    const int r = std::countr_zero(m);
+                    prepared[r] = bvh.set_->prepare(rays[r], scratch);
+                }
+                PacketTriangleRays triangle_rays;
+                if (triangle_rays.accepts(prepared, open)) {
+                    auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+                        const BvhTriangleBlock* block = bvh.blocks_.data() + first;
+                        for (std::uint32_t left = count; left != 0; ++block) {
+                            const std::uint32_t block_lanes = std::min(left, kBlockLanes);
+                            left -= block_lanes;
+                            for (std::uint32_t lane = 0; lane < block_lanes; ++lane) {
+                                alignas(32) float sheared[9][8];
+                                unsigned candidates = triangle_rays.candidates(
+                                    *block, static_cast<int>(lane), open, sheared);
+                                while (candidates != 0) {
+                                    const int r = std::countr_zero(candidates);
+                                    candidates &= candidates - 1;
+                                    TriangleSet<float>::ShearedTriangle triangle;
+                                    for (int k = 0; k < 3; ++k) {
+                                        triangle.x[k] = sheared[k][r];
+                                        triangle.y[k] = sheared[3 + k][r];
+                                        triangle.z[k] = sheared[6 + k][r];
+                                    }
+                                    double t, b1, b2;
+                                    if (!TriangleSet<float>::hit_sheared(
+                                            triangle, prepared[r].shear_z, t, b1, b2)) {
+                                        continue;
+                                    }
+                                    if constexpr (kAny) {
+                                        if (t >= prepared[r].t_min && t <= prepared[r].t_max) {
+                                            found[r] = true;
+                                            open &= ~(1u << r);
+                                        }
+                                    } else if (Set::keep_nearest(block->primitive[lane], t, b1, b2,
+                                                                 prepared[r], best[r])) {
+                                        found[r] = true;
+                                        lanes[r].t_max = round_up(best[r].t);
+                                    }
+                                }
+                                if (open == 0) return true;
+                            }
+                        }
+                        t_max = largest_t_max();
+                        return false;
+                    };
+                    walk_wide<false, false>(bvh, bvh.nodes_8_, test, largest_t_max(), unused, leaf);
+                    return;
+                }
+            }
+        }
+        auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+            for (std::uint32_t m = open; m != 0; m &= m - 1) {
+                const int r = std::countr_zero(m);
+                const auto& leaf_ray = lanes.leaf(r, *bvh.set_, rays[r], scratch);
+                if constexpr (kAny) {
+                    if (occluded_in_leaf<false>(bvh, leaf_ray, first, count, unused)) {
+                        found[r] = true;
+                        open &= ~(1u << r);
+                    }
+                } else {
+                    found[r] |= nearest_in_leaf<false>(bvh, leaf_ray, first, count, best[r],
+                                                       lanes[r].t_max, unused);
+                }
+            }
+            t_max = largest_t_max();
+            return open == 0;
+        };
+        walk_wide<false, false>(bvh, bvh.nodes_8_, test, largest_t_max(), unused, leaf);
     }
 #endif
 

@@ -59,6 +59,10 @@ std::vector<Variant> mesh_variants(bool with_double, bool with_robust) {
     for (std::string_view name : accelerator_names()) {
         if (name != "brute") variants.push_back(structure_variant(name, false));
     }
+    Variant bvh_packets = structure_variant("bvh", false);
+    bvh_packets.name = "bvh-packet";
+    bvh_packets.packets = true;
+    variants.push_back(bvh_packets);
     if (with_double) {
         for (std::string_view name : accelerator_names()) {
             if (name != "brute") variants.push_back(structure_variant(name, true));

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/accel/bvh.h"
+#include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/query_scratch.h"
 #include "csgrt/core/ray.h"
 
@@ -64,6 +66,38 @@ public:
 
 private:
     const Accelerator<Set>& structure_;
+};
+
+/// csgrt's BVH tracing Bvh::kPacketRays consecutive rays together (intersect_packets,
+/// occluded_packets), the answers bit-identical to the single-ray queries.
+class BvhPacketTracer final : public Tracer {
+public:
+    explicit BvhPacketTracer(const Bvh<TriangleSet<float>>& bvh) : bvh_(bvh) {}
+
+    std::size_t nearest(std::span<const Ray> rays, QueryScratch& scratch) const override {
+        std::size_t hits = 0;
+        HitRecord records[kChunk];
+        bool hit[kChunk];
+        for (std::size_t begin = 0; begin < rays.size(); begin += kChunk) {
+            const std::size_t n = std::min(kChunk, rays.size() - begin);
+            hits += bvh_.intersect_packets(rays.subspan(begin, n), std::span(records, n),
+                                           std::span(hit, n), scratch);
+        }
+        return hits;
+    }
+    std::size_t occluded(std::span<const Ray> rays, QueryScratch& scratch) const override {
+        std::size_t hits = 0;
+        bool occluded[kChunk];
+        for (std::size_t begin = 0; begin < rays.size(); begin += kChunk) {
+            const std::size_t n = std::min(kChunk, rays.size() - begin);
+            hits += bvh_.occluded_packets(rays.subspan(begin, n), std::span(occluded, n), scratch);
+        }
+        return hits;
+    }
+
+private:
+    static constexpr std::size_t kChunk = 256;
+    const Bvh<TriangleSet<float>>& bvh_;
 };
 
 /// Runs `trace(begin, end, scratch)` over [0, count) on `threads` threads (the calling thread

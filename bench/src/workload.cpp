@@ -8,6 +8,7 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "csgrt/accel/bvh.h"
 #include "csgrt/accel/factory.h"
 #include "peers.h"
 
@@ -204,8 +205,14 @@ const Tracer& MeshWorkload::tracer(const Variant& variant, VariantFacts* facts) 
                 } else {
                     built->float_structure =
                         make_accelerator(variant.structure, float_set(), config_of(variant));
-                    built->tracer = std::make_unique<AcceleratorTracer<TriangleSet<float>>>(
-                        *built->float_structure);
+                    const auto* bvh =
+                        dynamic_cast<const Bvh<TriangleSet<float>>*>(built->float_structure.get());
+                    if (variant.packets && bvh != nullptr) {
+                        built->tracer = std::make_unique<BvhPacketTracer>(*bvh);
+                    } else {
+                        built->tracer = std::make_unique<AcceleratorTracer<TriangleSet<float>>>(
+                            *built->float_structure);
+                    }
                     built->facts = facts_of(*built->float_structure, float_set());
                 }
                 break;

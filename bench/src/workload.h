@@ -33,7 +33,8 @@ struct Variant {
     bool box_culling = false;
     /// Embree's RTC_SCENE_FLAG_ROBUST.
     bool robust = false;
-    /// Embree's packet queries (rtcIntersect8 / rtcOccluded8) instead of one ray at a time.
+    /// Packet queries instead of one ray at a time: Embree's rtcIntersect8 / rtcOccluded8,
+    /// or the BVH's intersect_packets / occluded_packets (structure "bvh", float).
     bool packets = false;
 
     /// Brute force is O(N) per ray, so it traces a bounded subset of each ray set.

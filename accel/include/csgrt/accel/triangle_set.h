@@ -89,6 +89,26 @@ private:
 // everywhere.
 
 template <class Real>
+inline typename TriangleSet<Real>::PreparedRay TriangleSet<Real>::prepare(const Ray& ray,
+                                                                   QueryScratch&) const {
+    PreparedRay prepared;
+    prepared.origin = ray.origin.cast<Real>();
+    // z is the dominant direction axis, so the shear never divides by a small number; x and y
+    // follow cyclically (the winding is carried by the sign of det, not by a swap).
+    prepared.axis_z = max_dimension(ray.direction);
+    prepared.axis_x = prepared.axis_z == 2 ? 0 : prepared.axis_z + 1;
+    prepared.axis_y = prepared.axis_x == 2 ? 0 : prepared.axis_x + 1;
+    // The ratios are formed in double and rounded once.
+    const Vector3& direction = ray.direction;
+    prepared.shear_z = 1.0 / direction[prepared.axis_z];
+    prepared.shear_x = static_cast<Real>(direction[prepared.axis_x] / direction[prepared.axis_z]);
+    prepared.shear_y = static_cast<Real>(direction[prepared.axis_y] / direction[prepared.axis_z]);
+    prepared.t_min = ray.t_min;
+    prepared.t_max = ray.t_max;
+    return prepared;
+}
+
+template <class Real>
 inline typename TriangleSet<Real>::ShearedTriangle TriangleSet<Real>::shear(
     std::size_t i, const PreparedRay& ray) const {
     const auto& c = corners_[i];
