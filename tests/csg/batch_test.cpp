@@ -10,13 +10,13 @@
 
 #include "csgrt/accel/closest_point.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/box.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
 #include "csgrt/core/plane.h"
 #include "csgrt/core/sphere.h"
 #include "csgrt/csg/boolean.h"
+#include "csgrt/mesh/mesh.h"
 #include "support/meshes.h"
 #include "support/random.h"
 #include "support/rays.h"
@@ -94,9 +94,7 @@ struct NearestHits {
     std::vector<std::uint32_t> object, primitive;
     explicit NearestHits(std::size_t n)
         : t(n), uv(2 * n), geometric(3 * n), shading(3 * n), object(n), primitive(n) {}
-    NearestHitOutputs<Real> outputs() {
-        return {t, object, primitive, uv, geometric, shading};
-    }
+    NearestHitOutputs<Real> outputs() { return {t, object, primitive, uv, geometric, shading}; }
     bool operator==(const NearestHits&) const = default;
 };
 
@@ -270,8 +268,7 @@ TYPED_TEST(BatchTest, TriangleQueriesAgainstTheStructureBruteForceAndMembership)
     intersect(meshes.structure(), buffer.arrays(), all.outputs(), BatchConfig{2, 32});
     // Only t: the same t, and nothing else written.
     std::vector<Real> t_only(n);
-    intersect(meshes.structure(), buffer.arrays(), only_t(t_only),
-              threads(1));
+    intersect(meshes.structure(), buffer.arrays(), only_t(t_only), threads(1));
     EXPECT_EQ(t_only, all.t);
 
     QueryScratch scratch;
@@ -327,8 +324,8 @@ TYPED_TEST(BatchTest, TriangleQueriesAgainstTheStructureBruteForceAndMembership)
     std::size_t in_count = 0;
     for (std::size_t i = 0; i < view.count; ++i) {
         const Point3 p = view[i];
-        const bool expected = sphere.contains(p) ||
-                              Aabb(Point3(3, -1, -1), Point3(5, 1, 1)).contains(p);
+        const bool expected =
+            sphere.contains(p) || Aabb(Point3(3, -1, -1), Point3(5, 1, 1)).contains(p);
         // Within 1e-6 of a surface the parity and the reference may disagree on a rounding.
         if (distance[i] > Real(1e-4)) {
             ASSERT_EQ(inside[i] != 0, expected) << p.transpose();
@@ -341,6 +338,51 @@ TYPED_TEST(BatchTest, TriangleQueriesAgainstTheStructureBruteForceAndMembership)
         ASSERT_EQ(object[i], reference.primitive >= meshes.sphere_triangles ? 1u : 0u);
     }
     EXPECT_GT(in_count, 100u);
+}
+
+TYPED_TEST(BatchTest, CameraRaysThroughTheBvhPacketsAnswerAsSingleRays) {
+    // Rays from one eye go through Bvh's packet queries eight at a time (as one interval ray,
+    // with ray-parallel triangle tests): the answers must be the single-ray queries', ray by
+    // ray, for blocks that split packets (grain 13) and for brute force's answers too.
+    using Real = TypeParam;
+    const TwoMeshes<Real> meshes;
+    RayBuffer<Real> buffer;
+    const Point3 eye(1.9, 0.7, 6.0);
+    const int width = 61;
+    for (int y = 0; y < width; ++y) {
+        for (int x = 0; x < width; ++x) {
+            const Point3 target(-1.2 + 6.4 * (x + 0.5) / width, -1.2 + 2.4 * (y + 0.5) / width,
+                                0.0);
+            buffer.add(Ray{eye, target - eye});
+        }
+    }
+    const std::size_t n = buffer.size();
+    NearestHits<Real> all(n);
+    intersect(meshes.structure(), buffer.arrays(), all.outputs(), BatchConfig{2, 13});
+    std::vector<std::uint8_t> occluded_out(n);
+    occluded(meshes.structure(), buffer.arrays(), std::span<std::uint8_t>(occluded_out),
+             BatchConfig{2, 13});
+    QueryScratch scratch;
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Ray ray = buffer.arrays().ray(i);
+        HitRecord single, brute;
+        const bool hit = meshes.bvh->intersect(ray, single, scratch);
+        ASSERT_EQ(hit, meshes.brute->intersect(ray, brute, scratch)) << i;
+        ASSERT_EQ(occluded_out[i] != 0, hit) << i;
+        if (!hit) {
+            ASSERT_EQ(all.t[i], std::numeric_limits<Real>::infinity()) << i;
+            continue;
+        }
+        ++hits;
+        ASSERT_EQ(single.t, brute.t) << i;
+        ASSERT_EQ(all.t[i], static_cast<Real>(single.t)) << i;
+        ASSERT_EQ(all.uv[2 * i], static_cast<Real>(single.u)) << i;
+        ASSERT_EQ(all.uv[2 * i + 1], static_cast<Real>(single.v)) << i;
+    }
+    // The grid covers both meshes and the gap between them.
+    EXPECT_GT(hits, n / 4);
+    EXPECT_LT(hits, n);
 }
 
 TYPED_TEST(BatchTest, SeparateArraysAndWrongSizesAreRefused) {
@@ -370,8 +412,7 @@ TYPED_TEST(BatchTest, SeparateArraysAndWrongSizesAreRefused) {
     EXPECT_THROW(separate_vectors<Real>(columns[0], columns[1], short_t, "origins"),
                  InvalidParameter);
     std::vector<Real> t(n);
-    EXPECT_THROW(intersect(scene, soa, only_t(t), threads(-1)),
-                 InvalidParameter);
+    EXPECT_THROW(intersect(scene, soa, only_t(t), threads(-1)), InvalidParameter);
     Scene uncommitted;
     EXPECT_THROW(intersect(uncommitted, soa, only_t(t)), InvalidParameter);
 }
