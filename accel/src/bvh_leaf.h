@@ -1,0 +1,270 @@
+#pragma once
+
+// The BVH's leaves of TriangleSet<float>: blocks of four triangles tested with the triangle
+// test's own float operations, four or eight lanes at a time, and the ray-parallel test of a
+// packet. Private to accel/src/bvh*.
+
+#include "bvh_ray.h"
+
+namespace csgrt::detail {
+
+/// Four triangles of a block sheared into the frame of the ray, lane by lane, with their edge
+/// functions.
+struct ShearedBlock {
+    Float4 x[3], y[3], z[3];
+    Float4 u, v, w;
+
+    /// Lane l as the set's scalar test would have computed it.
+    TriangleSet<float>::ShearedTriangle lane(int l) const {
+        alignas(16) float values[9][4];
+        for (int k = 0; k < 3; ++k) {
+            x[k].store(values[k]);
+            y[k].store(values[3 + k]);
+            z[k].store(values[6 + k]);
+        }
+        TriangleSet<float>::ShearedTriangle triangle;
+        for (int k = 0; k < 3; ++k) {
+            triangle.x[k] = values[k][l];
+            triangle.y[k] = values[3 + k][l];
+            triangle.z[k] = values[6 + k][l];
+        }
+        return triangle;
+    }
+};
+
+/// t and the barycentrics of corners 1 and 2 of a block's four lanes, from their edge
+/// functions: TriangleSet::hit_sheared's double arithmetic after its sign test, lane by lane in
+/// the same order (no fused multiply-add), so the same bits for a lane whose edge functions
+/// are non-zero and of one sign. Two lanes at a time with SSE2; one division for all four.
+struct BlockHits {
+    alignas(16) double t[4], b1[4], b2[4];
+
+    BlockHits(const ShearedBlock& block, double shear_z) {
+#if defined(__SSE2__)
+        const __m128d scale = _mm_set1_pd(shear_z), one = _mm_set1_pd(1.0);
+        for (int half = 0; half < 2; ++half) {
+            auto widen = [half](Float4 lanes) {
+                return _mm_cvtps_pd(half == 0 ? lanes.v : _mm_movehl_ps(lanes.v, lanes.v));
+            };
+            const __m128d u = widen(block.u), v = widen(block.v), w = widen(block.w);
+            const __m128d az = _mm_mul_pd(scale, widen(block.z[0]));
+            const __m128d bz = _mm_mul_pd(scale, widen(block.z[1]));
+            const __m128d cz = _mm_mul_pd(scale, widen(block.z[2]));
+            const __m128d scaled_t =
+                _mm_add_pd(_mm_add_pd(_mm_mul_pd(u, az), _mm_mul_pd(v, bz)), _mm_mul_pd(w, cz));
+            const __m128d inverse = _mm_div_pd(one, _mm_add_pd(_mm_add_pd(u, v), w));
+            _mm_store_pd(t + 2 * half, _mm_mul_pd(scaled_t, inverse));
+            _mm_store_pd(b1 + 2 * half, _mm_mul_pd(v, inverse));
+            _mm_store_pd(b2 + 2 * half, _mm_mul_pd(w, inverse));
+        }
+#else
+        alignas(16) float u[4], v[4], w[4], z[3][4];
+        block.u.store(u);
+        block.v.store(v);
+        block.w.store(w);
+        for (int k = 0; k < 3; ++k) block.z[k].store(z[k]);
+        for (int l = 0; l < 4; ++l) {
+            const double az = shear_z * double(z[0][l]), bz = shear_z * double(z[1][l]),
+                         cz = shear_z * double(z[2][l]);
+            const double scaled_t = double(u[l]) * az + double(v[l]) * bz + double(w[l]) * cz;
+            const double inverse = 1.0 / (double(u[l]) + double(v[l]) + double(w[l]));
+            t[l] = scaled_t * inverse;
+            b1[l] = double(v[l]) * inverse;
+            b2[l] = double(w[l]) * inverse;
+        }
+#endif
+    }
+};
+
+/// The first half of TriangleSet<float>'s test on the four triangles of a block at once: the
+/// same float operations as TriangleSet::shear and the edge functions of hit_sheared, lane by
+/// lane, so the values are the scalar test's bits. A lane whose three edge functions are
+/// non-zero and of mixed signs is a miss for the scalar test too (it only recomputes exact
+/// zeros).
+struct BlockRay {
+    /// The origin's and the shear's components, on the permuted axes (x, y, z of the test).
+    Float4 origin[3], shear_x, shear_y;
+    int axis[3];
+
+    explicit BlockRay(const TriangleSet<float>::PreparedRay& ray)
+        : shear_x(Float4::broadcast(ray.shear_x)), shear_y(Float4::broadcast(ray.shear_y)) {
+        axis[0] = ray.axis_x;
+        axis[1] = ray.axis_y;
+        axis[2] = ray.axis_z;
+        for (int a = 0; a < 3; ++a) origin[a] = Float4::broadcast(ray.origin[axis[a]]);
+    }
+
+    /// The lanes that may hit (bit l for lane l), the block sheared, and in `zeros` the lanes
+    /// with an edge function that is exactly zero (left to TriangleSet::hit_sheared, which
+    /// recomputes those in double). Every other candidate lane is a hit whose t and
+    /// barycentrics BlockHits gives.
+    unsigned candidates(const BvhTriangleBlock& block, ShearedBlock& sheared,
+                        unsigned& zeros) const {
+        for (int k = 0; k < 3; ++k) {
+            const Float4 px = Float4::load_aligned(block.corners[k][axis[0]]) - origin[0];
+            const Float4 py = Float4::load_aligned(block.corners[k][axis[1]]) - origin[1];
+            const Float4 pz = Float4::load_aligned(block.corners[k][axis[2]]) - origin[2];
+            sheared.x[k] = px - shear_x * pz;
+            sheared.y[k] = py - shear_y * pz;
+            sheared.z[k] = pz;
+        }
+        const Float4* x = sheared.x;
+        const Float4* y = sheared.y;
+        const Float4 u = sheared.u = x[2] * y[1] - y[2] * x[1];
+        const Float4 v = sheared.v = x[0] * y[2] - y[0] * x[2];
+        const Float4 w = sheared.w = x[1] * y[0] - y[1] * x[0];
+        const Float4 zero = Float4::broadcast(0.0f);
+        zeros = (equal(u, zero) | equal(v, zero) | equal(w, zero)).mask();
+        // Non-zero numbers' signs are their sign bits: mixed when some but not all are set.
+        // (A lane with a NaN gets a NaN t, kept or dropped here, and no query keeps it.)
+        const unsigned some_negative = (u | v | w).mask(), all_negative = (u & v & w).mask();
+        return (zeros | ~(some_negative & ~all_negative)) & 0xfu;
+    }
+};
+
+#if CSGRT_BVH_AVX2
+/// BlockRay::candidates on two consecutive blocks at once, lanes 0-3 the first and 4-7 the
+/// second, in 8-lane AVX2 steps: the same operations lane by lane (no fused multiply-add), so
+/// the same bits. Most leaves hold five to eight triangles, two blocks.
+struct alignas(32) Avx2BlockRay {
+    __m256 origin[3], shear_x, shear_y;
+    int axis[3];
+
+    [[gnu::target("avx2")]] explicit Avx2BlockRay(const BlockRay& ray) {
+        for (int a = 0; a < 3; ++a) {
+            origin[a] = _mm256_set_m128(ray.origin[a].v, ray.origin[a].v);
+            axis[a] = ray.axis[a];
+        }
+        shear_x = _mm256_set_m128(ray.shear_x.v, ray.shear_x.v);
+        shear_y = _mm256_set_m128(ray.shear_y.v, ray.shear_y.v);
+    }
+
+    // (Lambdas would not inherit the target attribute: these are functions.)
+    [[gnu::target("avx2")]] static __m256 load(const BvhTriangleBlock& first,
+                                               const BvhTriangleBlock& second, int k, int a) {
+        return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(first.corners[k][a])),
+                                    _mm_load_ps(second.corners[k][a]), 1);
+    }
+    [[gnu::target("avx2")]] static void split(__m256 lanes, Float4& low, Float4& high) {
+        low.v = _mm256_castps256_ps128(lanes);
+        high.v = _mm256_extractf128_ps(lanes, 1);
+    }
+
+    /// As BlockRay::candidates, bits 0-3 for `first` and 4-7 for `second`; `sheared` is
+    /// written only when some lane is a candidate.
+    [[gnu::target("avx2")]] unsigned candidates(const BvhTriangleBlock& first,
+                                                const BvhTriangleBlock& second,
+                                                ShearedBlock (&sheared)[2], unsigned& zeros) const {
+        __m256 x[3], y[3], z[3];
+        for (int k = 0; k < 3; ++k) {
+            const __m256 px = _mm256_sub_ps(load(first, second, k, axis[0]), origin[0]);
+            const __m256 py = _mm256_sub_ps(load(first, second, k, axis[1]), origin[1]);
+            const __m256 pz = _mm256_sub_ps(load(first, second, k, axis[2]), origin[2]);
+            x[k] = _mm256_sub_ps(px, _mm256_mul_ps(shear_x, pz));
+            y[k] = _mm256_sub_ps(py, _mm256_mul_ps(shear_y, pz));
+            z[k] = pz;
+        }
+        const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
+        const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
+        const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
+        const __m256 zero = _mm256_setzero_ps();
+        zeros = static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(
+            _mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
+            _mm256_cmp_ps(w, zero, _CMP_EQ_OQ))));
+        const unsigned some_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(u, v), w)));
+        const unsigned all_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(u, v), w)));
+        const unsigned result = (zeros | ~(some_negative & ~all_negative)) & 0xffu;
+        if (result != 0) {
+            for (int k = 0; k < 3; ++k) {
+                split(x[k], sheared[0].x[k], sheared[1].x[k]);
+                split(y[k], sheared[0].y[k], sheared[1].y[k]);
+                split(z[k], sheared[0].z[k], sheared[1].z[k]);
+            }
+            split(u, sheared[0].u, sheared[1].u);
+            split(v, sheared[0].v, sheared[1].v);
+            split(w, sheared[0].w, sheared[1].w);
+        }
+        return result;
+    }
+};
+#endif
+
+#if CSGRT_BVH_AVX2
+/// The rays of a packet as TriangleSet<float>'s test sees them, lane r holding ray r, for
+/// packets whose rays share the test's axis permutation: each triangle of a leaf is sheared
+/// into every ray's frame at once with the float operations of TriangleSet::shear and the edge
+/// functions of hit_sheared, lane by lane, so each lane holds its ray's own values (the
+/// ray-parallel leaf test of Wald et al., "Interactive Rendering with Coherent Ray Tracing",
+/// 2001). Lanes the sign test rules out are misses for the scalar test too; the others finish
+/// with TriangleSet::hit_sheared on their own values.
+struct alignas(32) PacketTriangleRays {
+    __m256 origin[3], shear_x, shear_y;
+    int axis[3];
+
+    /// Whether the open rays' prepared rays share their axes; if so, sets the lanes up.
+    [[gnu::target("avx2")]] bool accepts(const TriangleSet<float>::PreparedRay* prepared,
+                                         std::uint32_t open) {
+        const auto& first = prepared[std::countr_zero(open)];
+        alignas(32) float values[5][8] = {};
+        for (std::uint32_t m = open; m != 0; m &= m - 1) {
+            const int r = std::countr_zero(m);
+            const auto& ray = prepared[r];
+            if (ray.axis_z != first.axis_z) return false;
+            values[0][r] = ray.origin[ray.axis_x];
+            values[1][r] = ray.origin[ray.axis_y];
+            values[2][r] = ray.origin[ray.axis_z];
+            values[3][r] = ray.shear_x;
+            values[4][r] = ray.shear_y;
+        }
+        axis[0] = first.axis_x;
+        axis[1] = first.axis_y;
+        axis[2] = first.axis_z;
+        for (int a = 0; a < 3; ++a) origin[a] = _mm256_load_ps(values[a]);
+        shear_x = _mm256_load_ps(values[3]);
+        shear_y = _mm256_load_ps(values[4]);
+        return true;
+    }
+
+    /// The rays (bits of `rays`) for which triangle `lane` of `block` may be hit; where there
+    /// are some, `sheared` holds every ray's sheared corners (x, y, z of corners 0, 1, 2).
+    [[gnu::target("avx2")]] unsigned candidates(const BvhTriangleBlock& block, int lane,
+                                                unsigned rays, float (&sheared)[9][8]) const {
+        __m256 x[3], y[3], z[3];
+        for (int k = 0; k < 3; ++k) {
+            const __m256 px =
+                _mm256_sub_ps(_mm256_set1_ps(block.corners[k][axis[0]][lane]), origin[0]);
+            const __m256 py =
+                _mm256_sub_ps(_mm256_set1_ps(block.corners[k][axis[1]][lane]), origin[1]);
+            const __m256 pz =
+                _mm256_sub_ps(_mm256_set1_ps(block.corners[k][axis[2]][lane]), origin[2]);
+            x[k] = _mm256_sub_ps(px, _mm256_mul_ps(shear_x, pz));
+            y[k] = _mm256_sub_ps(py, _mm256_mul_ps(shear_y, pz));
+            z[k] = pz;
+        }
+        const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
+        const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
+        const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
+        const __m256 zero = _mm256_setzero_ps();
+        const unsigned zeros = static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(
+            _mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
+            _mm256_cmp_ps(w, zero, _CMP_EQ_OQ))));
+        const unsigned some_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(u, v), w)));
+        const unsigned all_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(u, v), w)));
+        const unsigned result = (zeros | ~(some_negative & ~all_negative)) & rays;
+        if (result != 0) {
+            for (int k = 0; k < 3; ++k) {
+                _mm256_store_ps(sheared[k], x[k]);
+                _mm256_store_ps(sheared[3 + k], y[k]);
+                _mm256_store_ps(sheared[6 + k], z[k]);
+            }
+        }
+        return result;
+    }
+};
+#endif
+
+}  // namespace csgrt::detail

@@ -1,0 +1,389 @@
+#pragma once
+
+// The BVH's ray against boxes: the ray as the float slab tests see it (BoxRay) and the node
+// tests of one ray (binary, 4 and 8 wide, SSE and AVX2) and of a packet with one origin.
+// Private to accel/src/bvh*.
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "bvh_simd.h"
+#include "csgrt/accel/bvh.h"
+#include "csgrt/accel/triangle_set.h"
+#include "csgrt/core/ray.h"
+
+// The AVX2 node test is compiled for x86-64 with GCC or Clang only, as functions with their own
+// target attribute: the library itself stays baseline x86-64, and build() picks the AVX2 code
+// only on a CPU that has it.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define CSGRT_BVH_AVX2 1
+#include <immintrin.h>
+#else
+#define CSGRT_BVH_AVX2 0
+#endif
+
+namespace csgrt::detail {
+
+inline constexpr float kFloatInfinity = std::numeric_limits<float>::infinity();
+inline constexpr double kFloatMax = std::numeric_limits<float>::max();
+/// Beyond this a coordinate or reciprocal direction component is not trusted to the float
+/// slab test (products could overflow or underflow to denormals).
+inline constexpr double kLargestBoxRayValue = 0x1p100;
+inline constexpr float kSlack = Bvh<TriangleSet<float>>::kSlabSlack;
+/// Triangles in a BvhTriangleBlock.
+inline constexpr std::uint32_t kBlockLanes = 4;
+
+/// The largest float <= x (x not NaN).
+inline float round_down(double x) {
+    if (x > kFloatMax) return static_cast<float>(kFloatMax);
+    if (x < -kFloatMax) return -kFloatInfinity;
+    float f = static_cast<float>(x);
+    if (double(f) > x) f = std::nextafter(f, -kFloatInfinity);
+    return f;
+}
+
+/// The smallest float >= x (x not NaN).
+inline float round_up(double x) {
+    if (x > kFloatMax) return kFloatInfinity;
+    if (x < -kFloatMax) return -static_cast<float>(kFloatMax);
+    float f = static_cast<float>(x);
+    if (double(f) < x) f = std::nextafter(f, kFloatInfinity);
+    return f;
+}
+
+/// The ray as the float slab tests see it. The origin is rounded to nearest, as the float
+/// triangle test rounds it, so both tests measure t from the same point.
+///
+/// The slack widens [t_enter, t_exit] by kSlabSlack of its magnitude at both ends. When
+/// t_min >= 0 only non-negative distances can matter (a negative t_exit means a miss either
+/// way, and rounding never flips a sign), so it is folded into the reciprocals: near planes
+/// use (1 - slack) / d, far planes (1 + slack) / d. Otherwise (`signed_interval`) the
+/// traversal widens each interval by its magnitude.
+struct BoxRay {
+    // Lane 3 of each is padding (written as four floats at once).
+    float origin[4];
+    float inverse_near[4];
+    float inverse_far[4];
+    /// Whether the direction's sign bit is set (-0 included): the box's upper face is then
+    /// the near one, and the products below never form 0 * inf except in a face's plane.
+    bool negative[3];
+    bool signed_interval;
+    /// is_valid(ray), found from the representability test where it can be (see below).
+    bool valid;
+    float t_min;
+
+    // Inlined into the query: it runs once a ray, and most camera rays never reach a leaf.
+    // With SSE2 the representability test and the reciprocals take the components two and
+    // four at a time (divps and cvtpd2ps round lane by lane exactly as divss and cvtsd2ss do),
+    // and the common case of round_down (t_min a float: 0 or -inf) is taken first.
+    [[gnu::always_inline]] explicit BoxRay(const Ray& ray) {
+        const float t_min_float = static_cast<float>(ray.t_min);
+        t_min = double(t_min_float) <= ray.t_min && t_min_float != kFloatInfinity
+                    ? t_min_float
+                    : round_down(ray.t_min);
+        signed_interval = !(t_min >= 0.0f);
+#if defined(__SSE2__)
+        const double* o = ray.origin.data();
+        const double* d = ray.direction.data();
+        // (o0, o1), (o2, d0), (d1, d2).
+        const __m128d v0 = _mm_loadu_pd(o), v1 = _mm_set_pd(d[0], o[2]), v2 = _mm_loadu_pd(d + 1);
+        const __m128d sign = _mm_set1_pd(-0.0), zero = _mm_setzero_pd();
+        const __m128d largest = _mm_set1_pd(kLargestBoxRayValue);
+        const __m128d smallest = _mm_set1_pd(1.0 / kLargestBoxRayValue);
+        const __m128d a0 = _mm_andnot_pd(sign, v0), a1 = _mm_andnot_pd(sign, v1),
+                      a2 = _mm_andnot_pd(sign, v2);
+        // Every |component| <= 2^100 (false for NaN); each direction component 0 or >= 2^-100.
+        const __m128d small_ok1 =
+            _mm_or_pd(_mm_or_pd(_mm_cmpge_pd(a1, smallest), _mm_cmpeq_pd(v1, zero)),
+                      _mm_castsi128_pd(_mm_set_epi32(0, 0, -1, -1)));
+        const __m128d small_ok2 = _mm_or_pd(_mm_cmpge_pd(a2, smallest), _mm_cmpeq_pd(v2, zero));
+        const __m128d ok = _mm_and_pd(
+            _mm_and_pd(_mm_cmple_pd(a0, largest), _mm_and_pd(_mm_cmple_pd(a1, largest), small_ok1)),
+            _mm_and_pd(_mm_cmple_pd(a2, largest), small_ok2));
+        const bool representable = _mm_movemask_pd(ok) == 3;
+        const int signs = _mm_movemask_pd(v1) >> 1 | _mm_movemask_pd(v2) << 1;
+        for (int axis = 0; axis < 3; ++axis) negative[axis] = (signs >> axis) & 1;
+        // A representable ray has a finite origin and direction, and a non-zero direction
+        // component is at least 2^-100, so its squared norm (>= 2^-200) is positive exactly
+        // when some component is not zero; t_min <= t_max is false for NaN. So is_valid
+        // reduces to two tests, and only the rare unrepresentable ray pays for the full one.
+        const int zero_direction = _mm_movemask_pd(_mm_cmpeq_pd(v1, zero)) >> 1 |
+                                   _mm_movemask_pd(_mm_cmpeq_pd(v2, zero)) << 1;
+        valid = representable ? zero_direction != 7 && ray.t_min <= ray.t_max : is_valid(ray);
+#else
+        bool representable = true;
+        for (int axis = 0; axis < 3; ++axis) {
+            const double d = ray.direction[axis], magnitude = std::abs(d);
+            representable &= (std::abs(ray.origin[axis]) <= kLargestBoxRayValue) &
+                             ((d == 0.0) | ((magnitude <= kLargestBoxRayValue) &
+                                            (magnitude >= 1.0 / kLargestBoxRayValue)));
+            negative[axis] = std::signbit(d);
+        }
+        valid = is_valid(ray);
+#endif
+        if (!representable) [[unlikely]] {
+            // Every slab distance becomes NaN, which the tests ignore: every box is entered.
+            for (int axis = 0; axis < 4; ++axis) {
+                origin[axis] = 0.0f;
+                inverse_near[axis] = inverse_far[axis] = std::numeric_limits<float>::quiet_NaN();
+            }
+            t_min = -kFloatInfinity;
+            signed_interval = true;
+            return;
+        }
+        const float near_scale = signed_interval ? 1.0f : 1.0f - kSlack;
+        const float far_scale = signed_interval ? 1.0f : 1.0f + kSlack;
+#if defined(__SSE2__)
+        // Lane 3 is padding: origin 0, direction 1.
+        const __m128 origin4 = _mm_movelh_ps(_mm_cvtpd_ps(v0), _mm_cvtpd_ps(_mm_move_sd(zero, v1)));
+        const __m128 direction4 =
+            _mm_movelh_ps(_mm_cvtpd_ps(_mm_shuffle_pd(v1, v2, 1)),
+                          _mm_cvtpd_ps(_mm_unpackhi_pd(v2, _mm_set1_pd(1.0))));
+        // +-0 gives +-inf, whose products with plane distances are +-inf or NaN.
+        const __m128 inverse = _mm_div_ps(_mm_set1_ps(1.0f), direction4);
+        _mm_storeu_ps(origin, origin4);
+        _mm_storeu_ps(inverse_near, _mm_mul_ps(inverse, _mm_set1_ps(near_scale)));
+        _mm_storeu_ps(inverse_far, _mm_mul_ps(inverse, _mm_set1_ps(far_scale)));
+#else
+        for (int axis = 0; axis < 3; ++axis) {
+            origin[axis] = static_cast<float>(ray.origin[axis]);
+            // +-0 gives +-inf, whose products with plane distances are +-inf or NaN.
+            const float inverse = 1.0f / static_cast<float>(ray.direction[axis]);
+            inverse_near[axis] = inverse * near_scale;
+            inverse_far[axis] = inverse * far_scale;
+        }
+#endif
+    }
+    /// Offsets (in floats) of the rows of WideBvhNode<kWidth>::bounds that hold each axis'
+    /// near and far planes.
+    int near_row(int axis, int width) const {
+        return (2 * axis + (negative[axis] ? 1 : 0)) * width;
+    }
+    int far_row(int axis, int width) const {
+        return (2 * axis + (negative[axis] ? 0 : 1)) * width;
+    }
+};
+
+/// Conservative slab test of one binary node's box: [t_enter, t_exit] clipped to
+/// [t_min, t_max] and widened by the slack; true when it is not empty. An empty box gives an
+/// empty interval (or NaN, which compares false).
+template <bool kSigned>
+bool hit_box(const BvhNode& node, const BoxRay& ray, float t_max, float& t_enter) {
+    float t0 = ray.t_min, t1 = t_max;
+    for (int axis = 0; axis < 3; ++axis) {
+        const float near_plane = ray.negative[axis] ? node.upper[axis] : node.lower[axis];
+        const float far_plane = ray.negative[axis] ? node.lower[axis] : node.upper[axis];
+        const float t_near = (near_plane - ray.origin[axis]) * ray.inverse_near[axis];
+        const float t_far = (far_plane - ray.origin[axis]) * ray.inverse_far[axis];
+        // NaN (0 * inf: a ray parallel to the slab, in a face's plane) leaves t0, t1 as they
+        // are: the ray is inside that slab for every t.
+        t0 = t_near > t0 ? t_near : t0;
+        t1 = t_far < t1 ? t_far : t1;
+    }
+    if constexpr (kSigned) {
+        t0 -= std::abs(t0) * kSlack;
+        t1 += std::abs(t1) * kSlack;
+    }
+    t_enter = t0;
+    return t0 <= t1;
+}
+
+/// The boxes of a wide node, four at a time, with the arithmetic of hit_box lane by lane
+/// except for NaN slabs: max and min return their second operand when either is NaN, so a
+/// NaN drops one slab (or two), which only widens the interval; t_min and t_max come last, so
+/// the result is never NaN.
+template <int kWidth>
+struct SseNodeTest {
+    Float4 origin[3], inverse_near[3], inverse_far[3], t_min;
+    int near_row[3], far_row[3];
+
+    explicit SseNodeTest(const BoxRay& ray) {
+        for (int axis = 0; axis < 3; ++axis) {
+            origin[axis] = Float4::broadcast(ray.origin[axis]);
+            inverse_near[axis] = Float4::broadcast(ray.inverse_near[axis]);
+            inverse_far[axis] = Float4::broadcast(ray.inverse_far[axis]);
+            near_row[axis] = ray.near_row(axis, kWidth);
+            far_row[axis] = ray.far_row(axis, kWidth);
+        }
+        t_min = Float4::broadcast(ray.t_min);
+    }
+
+    /// Bit i of the result says child i is entered, at t_enter[i] (16-byte aligned).
+    template <bool kSigned>
+    unsigned hit(const WideBvhNode<kWidth>& node, float t_max, float* t_enter) const {
+        unsigned mask = 0;
+        const Float4 t_max4 = Float4::broadcast(t_max);
+        for (int group = 0; group < kWidth; group += 4) {
+            const float* bounds = node.bounds[0] + group;
+            Float4 t_near[3], t_far[3];
+            for (int axis = 0; axis < 3; ++axis) {
+                t_near[axis] = (Float4::load_aligned(bounds + near_row[axis]) - origin[axis]) *
+                               inverse_near[axis];
+                t_far[axis] = (Float4::load_aligned(bounds + far_row[axis]) - origin[axis]) *
+                              inverse_far[axis];
+            }
+            Float4 t0 = max(max(t_near[0], t_near[1]), max(t_near[2], t_min));
+            Float4 t1 = min(min(t_far[0], t_far[1]), min(t_far[2], t_max4));
+            if constexpr (kSigned) {
+                const Float4 slack = Float4::broadcast(kSlack);
+                t0 = t0 - abs(t0) * slack;
+                t1 = t1 + abs(t1) * slack;
+            }
+            t0.store(t_enter + group);
+            mask |= (t0 <= t1).mask() << group;
+        }
+        return mask;
+    }
+};
+
+#if CSGRT_BVH_AVX2
+// The AVX2 types are aligned explicitly: compiled for baseline x86-64, GCC aligns a struct of
+// __m256 members to 16 bytes only, and the AVX2 code's aligned stores to it would fault.
+
+/// SseNodeTest<8> in one 8-lane AVX step: the same operations, lane by lane, in the same order
+/// (no fused multiply-add), so the same masks and entry distances.
+struct alignas(32) Avx2NodeTest {
+    __m256 origin[3], inverse_near[3], inverse_far[3], t_min;
+    int near_row[3], far_row[3];
+
+    [[gnu::target("avx2")]] explicit Avx2NodeTest(const BoxRay& ray) {
+        for (int axis = 0; axis < 3; ++axis) {
+            origin[axis] = _mm256_set1_ps(ray.origin[axis]);
+            inverse_near[axis] = _mm256_set1_ps(ray.inverse_near[axis]);
+            inverse_far[axis] = _mm256_set1_ps(ray.inverse_far[axis]);
+            near_row[axis] = ray.near_row(axis, 8);
+            far_row[axis] = ray.far_row(axis, 8);
+        }
+        t_min = _mm256_set1_ps(ray.t_min);
+    }
+
+    /// As SseNodeTest<8>::hit; t_enter must be 32-byte aligned.
+    template <bool kSigned>
+    [[gnu::target("avx2")]] unsigned hit(const Bvh8Node& node, float t_max, float* t_enter) const {
+        const float* bounds = node.bounds[0];
+        __m256 t_near[3], t_far[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            t_near[axis] =
+                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(bounds + near_row[axis]), origin[axis]),
+                              inverse_near[axis]);
+            t_far[axis] =
+                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(bounds + far_row[axis]), origin[axis]),
+                              inverse_far[axis]);
+        }
+        __m256 t0 =
+            _mm256_max_ps(_mm256_max_ps(t_near[0], t_near[1]), _mm256_max_ps(t_near[2], t_min));
+        __m256 t1 = _mm256_min_ps(_mm256_min_ps(t_far[0], t_far[1]),
+                                  _mm256_min_ps(t_far[2], _mm256_set1_ps(t_max)));
+        if constexpr (kSigned) {
+            const __m256 sign = _mm256_set1_ps(-0.0f), slack = _mm256_set1_ps(kSlack);
+            t0 = _mm256_sub_ps(t0, _mm256_mul_ps(_mm256_andnot_ps(sign, t0), slack));
+            t1 = _mm256_add_ps(t1, _mm256_mul_ps(_mm256_andnot_ps(sign, t1), slack));
+        }
+        _mm256_store_ps(t_enter, t0);
+        return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+    }
+};
+#endif
+
+#if CSGRT_BVH_AVX2
+/// The node test of a packet of rays whose directions share their signs, taken as intervals
+/// (interval arithmetic culling: Wald, Boulos and Shirley, "Ray Tracing Deformable Scenes
+/// Using Dynamic Bounding Volume Hierarchies", ACM TOG 2007). On each axis the rays' origins
+/// span [o_low, o_high] and their (slack-scaled) reciprocals [near_low, near_high] and
+/// [far_low, far_high], all of one sign. Rounding to nearest is monotone, so fl(b - o) and
+/// fl(x * inverse) move the way their exact values do, and each ray's own near distance
+/// fl(fl(b - o_r) * near_r) is at least the smaller of fl(fl(b - o) * near_low) and
+/// fl(fl(b - o) * near_high) with o the end of the origin interval that makes b - o least
+/// along the ray (o_high for a positive direction, o_low for a negative one); likewise each
+/// far distance is at most the larger of the two products from the other end. So the
+/// packet's [t_enter, t_exit] contains every ray's, and the packet enters every child that
+/// one of its rays would enter: the leaves it reaches include each ray's own. Rays that could
+/// make a slab distance NaN (a zero direction component, an unrepresentable ray) or need the
+/// signed-interval widening are not accepted, nor packets without a common origin; those go
+/// one ray at a time.
+struct alignas(32) PacketIntervalTest {
+    __m256 near_origin[3], far_origin[3], near_low[3], near_high[3], far_low[3], far_high[3];
+    __m256 t_min;
+    int near_row[3], far_row[3];
+
+    /// Whether the open rays of `lanes` (bits of `open`) can be walked as one; if so, sets the
+    /// test up.
+    template <class Lanes>
+    [[gnu::target("avx2")]] bool accepts(const Lanes& lanes, std::uint32_t open) {
+        const BoxRay& first = lanes[std::countr_zero(open)].box;
+        float o_low[3], o_high[3], n_low[3], n_high[3], f_low[3], f_high[3];
+        float lowest_t_min = kFloatInfinity;
+        for (int axis = 0; axis < 3; ++axis) {
+            o_low[axis] = n_low[axis] = f_low[axis] = kFloatInfinity;
+            o_high[axis] = n_high[axis] = f_high[axis] = -kFloatInfinity;
+        }
+        for (std::uint32_t m = open; m != 0; m &= m - 1) {
+            const BoxRay& ray = lanes[std::countr_zero(m)].box;
+            if (ray.signed_interval) return false;
+            // One origin (a pinhole camera's rays): see traverse_packet.
+            if (!(ray.origin[0] == first.origin[0] && ray.origin[1] == first.origin[1] &&
+                  ray.origin[2] == first.origin[2])) {
+                return false;
+            }
+            lowest_t_min = std::min(lowest_t_min, ray.t_min);
+            for (int axis = 0; axis < 3; ++axis) {
+                // Finite reciprocals (false for the NaN of an unrepresentable ray and for the
+                // infinity of a zero component), and one sign per axis.
+                if (!(std::abs(ray.inverse_near[axis]) <= std::numeric_limits<float>::max() &&
+                      std::abs(ray.inverse_far[axis]) <= std::numeric_limits<float>::max()) ||
+                    ray.negative[axis] != first.negative[axis]) {
+                    return false;
+                }
+                o_low[axis] = std::min(o_low[axis], ray.origin[axis]);
+                o_high[axis] = std::max(o_high[axis], ray.origin[axis]);
+                n_low[axis] = std::min(n_low[axis], ray.inverse_near[axis]);
+                n_high[axis] = std::max(n_high[axis], ray.inverse_near[axis]);
+                f_low[axis] = std::min(f_low[axis], ray.inverse_far[axis]);
+                f_high[axis] = std::max(f_high[axis], ray.inverse_far[axis]);
+            }
+        }
+        for (int axis = 0; axis < 3; ++axis) {
+            const bool negative = first.negative[axis];
+            near_origin[axis] = _mm256_set1_ps(negative ? o_low[axis] : o_high[axis]);
+            far_origin[axis] = _mm256_set1_ps(negative ? o_high[axis] : o_low[axis]);
+            near_low[axis] = _mm256_set1_ps(n_low[axis]);
+            near_high[axis] = _mm256_set1_ps(n_high[axis]);
+            far_low[axis] = _mm256_set1_ps(f_low[axis]);
+            far_high[axis] = _mm256_set1_ps(f_high[axis]);
+            near_row[axis] = first.near_row(axis, 8);
+            far_row[axis] = first.far_row(axis, 8);
+        }
+        t_min = _mm256_set1_ps(lowest_t_min);
+        return true;
+    }
+
+    /// As Avx2NodeTest::hit<false> for the whole packet; t_enter must be 32-byte aligned.
+    template <bool kSigned>
+    [[gnu::target("avx2")]] unsigned hit(const Bvh8Node& node, float t_max, float* t_enter) const {
+        static_assert(!kSigned, "packets with signed intervals are walked ray by ray");
+        const float* bounds = node.bounds[0];
+        __m256 t_near[3], t_far[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            const __m256 near_distance =
+                _mm256_sub_ps(_mm256_load_ps(bounds + near_row[axis]), near_origin[axis]);
+            const __m256 far_distance =
+                _mm256_sub_ps(_mm256_load_ps(bounds + far_row[axis]), far_origin[axis]);
+            t_near[axis] = _mm256_min_ps(_mm256_mul_ps(near_distance, near_low[axis]),
+                                         _mm256_mul_ps(near_distance, near_high[axis]));
+            t_far[axis] = _mm256_max_ps(_mm256_mul_ps(far_distance, far_low[axis]),
+                                        _mm256_mul_ps(far_distance, far_high[axis]));
+        }
+        const __m256 t0 =
+            _mm256_max_ps(_mm256_max_ps(t_near[0], t_near[1]), _mm256_max_ps(t_near[2], t_min));
+        const __m256 t1 = _mm256_min_ps(_mm256_min_ps(t_far[0], t_far[1]),
+                                        _mm256_min_ps(t_far[2], _mm256_set1_ps(t_max)));
+        _mm256_store_ps(t_enter, t0);
+        return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+    }
+};
+#endif
+
+}  // namespace csgrt::detail
