@@ -158,7 +158,11 @@ TEST(SceneFile, EveryShapeTypeLoads) {
          "theta_min": 270, "theta_max": 450},
         {"type": "mesh", "path": "box.off"},
         {"type": "difference", "operands": [{"type": "mesh", "path": "box.off"},
-                                            {"type": "sphere", "radius": 1}]}
+                                            {"type": "sphere", "radius": 1}]},
+        {"type": "half_space", "normal": [0, 1, 0]},
+        {"type": "not", "operand": {"type": "sphere", "radius": 1}},
+        {"type": "array", "item": {"type": "sphere", "radius": 1},
+         "copies": [{}, {"transform": [{"translate": [3, 0, 0]}]}]}
       ],
       "definitions": {"ball": {"type": "sphere", "radius": 0.25}}
     })",
@@ -173,14 +177,16 @@ TEST(SceneFile, EveryShapeTypeLoads) {
         "union", "intersection", "difference", "compound",
         "instance", "instance", "instance", "instance",  // the grid's copies
         "sphere",                                        // the definition itself
-        "torus", "part_torus", "mesh", "difference"};
+        "torus", "part_torus", "mesh", "difference",
+        "half_space", "not", "sphere", "instance"};  // the array's copies: as is, then moved
     EXPECT_EQ(kinds, expected);
     // Every type of the table is used above.
     const std::set<std::string_view> used = {
         "sphere", "plane", "triangle", "disk", "rectangle", "box", "cylinder", "cone",
         "part_sphere", "part_cylinder", "annulus", "torus", "part_torus", "mesh",
         "solid_cylinder", "solid_cone", "thick_ring", "bowl", "rounded_box",
-        "union", "intersection", "difference", "compound", "grid", "ref"};
+        "union", "intersection", "difference", "compound", "grid", "ref", "half_space", "not",
+        "array"};
     // clang-format on
     for (std::string_view type : scene_shape_types()) {
         EXPECT_TRUE(used.contains(type)) << type << " is not tested here";

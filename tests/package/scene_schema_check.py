@@ -40,6 +40,11 @@ BEYOND_THE_SCHEMA = {
     "unknown_definition.json": "references to definitions",
     "unknown_material.json": "references to materials",
     "light_rectangle_parallel_edges.json": "parallel edges compare two vectors",
+    "array_copy_material_nested.json": "an array node is one definition, top level or nested",
+    "array_copy_unknown_material.json": "references to materials",
+    "array_transform_product_overflow.json": "a product of the transform steps",
+    "grid_copy_transform_overflow.json": "a power of the copy transform",
+    "material_ramp_glass_and_paint.json": "the index of refraction of the named materials",
 }
 
 

@@ -49,6 +49,14 @@ inline std::vector<ExampleKind> example_kinds() {
                         return std::make_pair(ShapePointer(std::make_shared<Plane>(c, normal)),
                                               ReferencePointer(reference_plane(c, normal)));
                     }});
+    // A solid whose hits are the plane's: the same reference, every suite's solid checks too.
+    list.push_back({"half_space", [](const Point3& c, double s, Point3& placed) {
+                        placed = c;
+                        const Normal3 normal(-2, 1, 0.5);
+                        (void)s;
+                        return std::make_pair(ShapePointer(std::make_shared<HalfSpace>(c, normal)),
+                                              ReferencePointer(reference_plane(c, normal)));
+                    }});
     list.push_back({"triangle", [](const Point3& c, double s, Point3& placed) {
                         placed = c;
                         const Point3 a = c + s * Vector3(-1, -0.5, 0.2);

@@ -57,8 +57,8 @@ void Fields::finish() const {
         std::string message = "unknown key " + quote_name(it.key()) + " in " + what_;
         if (it.key() == "material" || it.key() == "name") {
             message += " (\"" + it.key() + "\" belongs to the top-level objects)";
-        } else if (it.key() == "materials") {
-            message += " (\"materials\" belongs to top-level grids)";
+        } else if (it.key() == "materials" || it.key() == "material_ramp") {
+            message += " (\"" + it.key() + "\" belongs to top-level grids and arrays)";
         }
         std::string known;
         for (const std::string& key : asked_) known += (known.empty() ? "" : ", ") + key;

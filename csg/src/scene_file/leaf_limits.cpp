@@ -97,8 +97,14 @@ private:
             leaves = list(value, "operands", depth);
         } else if (name == "compound") {
             leaves = list(value, "children", depth);
-        } else if (name == "grid") {
-            leaves = grid(value, depth);
+        } else if (name == "grid" || name == "array") {
+            leaves = copies(value, name == "grid", depth);
+        } else if (name == "not") {
+            const auto operand = value.find("operand");
+            if (operand == value.end()) return 1;
+            tokens_.push_back("operand");
+            leaves = node(*operand, depth + 1);
+            tokens_.pop_back();
         } else if (name == "ref") {
             const auto target = value.find("definition");
             if (target != value.end() && target->is_string()) {
@@ -130,12 +136,15 @@ private:
         return leaves;
     }
 
-    std::uint64_t grid(const Json& value, std::size_t depth) {
-        const auto count = value.find("count");
+    /// A grid's or an array's leaves: its copies (the product of a grid's counts, the length
+    /// of an array's list) times its item's.
+    std::uint64_t copies(const Json& value, bool is_grid, std::size_t depth) {
+        const char* const key = is_grid ? "count" : "copies";
+        const auto count = value.find(key);
         const auto item = value.find("item");
         if (count == value.end() || item == value.end() || !count->is_array()) return 1;
-        std::uint64_t copies = 1;
-        for (const Json& axis : *count) {
+        std::uint64_t copies = is_grid ? 1 : count->size();
+        for (const Json& axis : is_grid ? *count : Json::array()) {
             // Malformed counts are the loader's to report; whole numbers multiply, saturating.
             if (!axis.is_number_unsigned() && !axis.is_number_integer()) return 1;
             const auto n = axis.get<std::int64_t>();
@@ -145,13 +154,14 @@ private:
                     ? std::numeric_limits<std::uint64_t>::max()
                     : copies * static_cast<std::uint64_t>(n);
         }
-        // Over one grid's copy limit: the loader refuses it before building its item.
-        if (copies > kMaxGridCopies) return 1;
+        // Over one grid's or array's copy limit: the loader refuses it before building its
+        // item.
+        if (copies == 0 || copies > kMaxGridCopies) return 1;
         tokens_.push_back("item");
         const std::uint64_t item_leaves = node(*item, depth + 1);
         tokens_.pop_back();
         if (item_leaves != 0 && copies > kMaxExpandedLeaves / item_leaves) {
-            tokens_.push_back("count");
+            tokens_.push_back(key);
             std::string message = count_text(copies);
             message.append(" copies of an item of ").append(std::to_string(item_leaves));
             message.append(" leaf shapes are more than the ");

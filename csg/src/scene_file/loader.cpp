@@ -27,7 +27,7 @@ ShapePointer Loader::shape(Fields& fields) {
         fields.fail("type", "unknown shape type " + quote_name(type) +
                                 "; expected one of: " + known_types());
     }
-    fields.set_what("a " + type);
+    fields.set_what(with_article(type));
     ShapePointer built;
     try {
         built = entry->build(fields, *this);
@@ -59,10 +59,8 @@ std::vector<ListItem> Loader::list(Fields& fields, std::string_view key, std::si
     for (std::size_t i = 0; i < array.size(); ++i) {
         const std::string at = child_pointer(pointer, i);
         Fields element(array[i], at, source_, "an element of \"" + std::string(key) + "\"");
-        if (element.has("type") && array[i].at("type") == "grid") {
-            element.string("type");
-            element.set_what("a grid");
-            for (ShapePointer& copy : grid(element)) items.push_back({std::move(copy), at});
+        if (is_copies_node(array[i])) {
+            for (Copy& copy : copies(element, false)) items.push_back({std::move(copy.shape), at});
         } else {
             items.push_back({shape(element), at});
         }
@@ -70,79 +68,10 @@ std::vector<ListItem> Loader::list(Fields& fields, std::string_view key, std::si
     }
     if (items.size() < minimum) {
         fields.fail(key, "expected at least " + std::to_string(minimum) + " " + std::string(of) +
-                             " (after expanding grids), got " + std::to_string(items.size()));
+                             " (after expanding grids and arrays), got " +
+                             std::to_string(items.size()));
     }
     return items;
-}
-
-std::vector<ShapePointer> Loader::grid(Fields& fields) {
-    const Json& count = fields.required("count", "an array of 3 whole numbers >= 1");
-    if (!count.is_array() || count.size() != 3) {
-        fields.fail("count", "expected an array of 3 whole numbers >= 1, got " + describe(count));
-    }
-    std::size_t counts[3];
-    std::size_t total = 1;
-    for (int axis = 0; axis < 3; ++axis) {
-        counts[axis] = fields.to_count(count[axis], child_pointer(fields.pointer("count"), axis));
-        if (counts[axis] == 0) {
-            fields.fail("count",
-                        "expected every count >= 1, got 0 at index " + std::to_string(axis));
-        }
-        // Both factors stay <= kMaxGridCopies + 1, so the product cannot overflow.
-        total = counts[axis] > kMaxGridCopies ? kMaxGridCopies + 1
-                                              : std::min(total * counts[axis], kMaxGridCopies + 1);
-    }
-    if (total > kMaxGridCopies) {
-        fields.fail("count",
-                    "expected at most " + std::to_string(kMaxGridCopies) + " copies in one grid");
-    }
-    const Vector3 spacing = fields.vector("spacing");
-    const ShapePointer item =
-        shape(fields.required("item", "a shape node"), fields.pointer("item"), "a grid item");
-    // Refused before the copies are made: a grid of grids is a product.
-    const std::uint64_t item_leaves = expanded_leaves(*item, leaves_);
-    if (item_leaves > kMaxExpandedLeaves / total) {
-        fields.fail("count", std::to_string(total) + " copies of an item of " +
-                                 std::to_string(item_leaves) + " leaf shapes are more than the " +
-                                 std::to_string(kMaxExpandedLeaves) +
-                                 " leaves a scene may expand to (docs/scene-format.md, Limits)");
-    }
-    // Refused before the copies are made too: copies piled closer than their size.
-    const std::uint64_t piled = grid_overlap(counts, spacing, item->bounds());
-    if (const std::uint64_t overlap = piled * overlapping_leaves(*item, overlaps_);
-        overlap > kMaxOverlappingLeaves) {
-        std::string message = std::to_string(piled);
-        message.append(" copies meet at one point (\"spacing\" ")
-            .append(detail::describe(spacing))
-            .append(" against the item's size ")
-            .append(detail::describe(Vector3(item->bounds().diagonal())))
-            .append("): ")
-            .append(overlap_message(overlap));
-        fields.fail("count", message);
-    }
-    Transform placement;
-    if (fields.has("transform")) {
-        placement =
-            transform(fields.array("transform", 0, "transforms"), fields.pointer("transform"));
-    }
-    // Copies in x-fastest order, centred on the origin, then the grid's own transform.
-    std::vector<ShapePointer> copies;
-    copies.reserve(total);
-    for (std::size_t k = 0; k < counts[2]; ++k) {
-        for (std::size_t j = 0; j < counts[1]; ++j) {
-            for (std::size_t i = 0; i < counts[0]; ++i) {
-                const Vector3 offset(
-                    (static_cast<double>(i) - 0.5 * static_cast<double>(counts[0] - 1)) *
-                        spacing.x(),
-                    (static_cast<double>(j) - 0.5 * static_cast<double>(counts[1] - 1)) *
-                        spacing.y(),
-                    (static_cast<double>(k) - 0.5 * static_cast<double>(counts[2] - 1)) *
-                        spacing.z());
-                copies.push_back(place(item, placement * Transform::translate(offset)));
-            }
-        }
-    }
-    return copies;
 }
 
 ShapePointer Loader::definition(const std::string& name, const std::string& pointer) {
@@ -188,9 +117,9 @@ Scene Loader::load() {
          {"description", "camera", "materials", "lights", "definitions", "ambient", "background"})
         top.has(key);
     if (top.has("description")) top.string("description");
+    scene_ = &scene;
     camera(scene);
-    std::map<std::string, std::uint32_t> material_index;
-    materials(scene, material_index);
+    materials(scene, material_index_);
     lights(scene);
     ambient_and_background(scene);
     if (top.has("definitions")) {
@@ -215,61 +144,28 @@ Scene Loader::load() {
     }
     const Json& objects = top.array("objects", 0, "objects");
     top.finish();
-    auto material_of = [&](Fields& fields, const std::string& name) {
-        const auto found = material_index.find(name);
-        if (found == material_index.end()) {
-            std::string known;
-            std::size_t listed = 0;
-            for (const auto& [known_name, index] : material_index) {
-                if (++listed > 20) {
-                    known += ", ...";
-                    break;
-                }
-                known += (known.empty() ? "" : ", ") + shown(known_name);
-            }
-            fields.fail("material",
-                        "no material named " + quote_name(name) + "; defined: " + known);
-        }
-        return found->second;
-    };
-    // The file's object each scene object came from (a grid gives several).
+    // The file's object each scene object came from (a grid or an array gives several).
     std::vector<std::size_t> object_of;
     for (std::size_t i = 0; i < objects.size(); ++i) {
         Fields fields(objects[i], child_pointer("/objects", i), source_, "a scene object");
         const std::string name = fields.string("name", "");
-        const bool is_grid = fields.has("type") && objects[i].at("type") == "grid";
-        std::vector<std::uint32_t> palette;
-        if (is_grid && fields.has("materials")) {
-            const Json& names = fields.array("materials", 1, "material names");
-            for (std::size_t m = 0; m < names.size(); ++m) {
-                if (!names[m].is_string()) {
-                    source_.fail(child_pointer(fields.pointer("materials"), m),
-                                 "expected a material name, got " + describe(names[m]));
-                }
-                palette.push_back(material_of(fields, names[m].get<std::string>()));
-            }
-            if (fields.has("material")) {
-                fields.fail("material", "expected either \"material\" or \"materials\", not both");
-            }
-        } else {
-            palette.push_back(material_of(fields, fields.string("material", "default")));
-        }
-        if (is_grid) {
-            fields.string("type");
-            fields.set_what("a grid");
-            const auto copies = grid(fields);
+        fields.has("type");  // asked first, for the order of keys a message lists
+        if (is_copies_node(objects[i])) {
+            const std::vector<Copy> made = copies(fields, true);
             fields.finish();
-            for (const ShapePointer& copy : copies) count_leaves(*copy, fields.pointer());
-            for (std::size_t c = 0; c < copies.size(); ++c) {
-                scene.add_object(copies[c], palette[c % palette.size()],
+            for (const Copy& copy : made) count_leaves(*copy.shape, fields.pointer());
+            for (std::size_t c = 0; c < made.size(); ++c) {
+                scene.add_object(made[c].shape, made[c].material,
                                  name.empty() ? name : name + "[" + std::to_string(c) + "]");
             }
-            object_of.insert(object_of.end(), copies.size(), i);
+            object_of.insert(object_of.end(), made.size(), i);
         } else {
+            const std::uint32_t material =
+                material_named(fields, "material", fields.string("material", "default"));
             ShapePointer built = shape(fields);
             fields.finish();
             count_leaves(*built, fields.pointer());
-            scene.add_object(std::move(built), palette.front(), name);
+            scene.add_object(std::move(built), material, name);
             object_of.push_back(i);
         }
     }

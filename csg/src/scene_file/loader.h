@@ -43,6 +43,18 @@ struct ListItem {
     std::string pointer;
 };
 
+/// One copy made by a grid or an array node: the shape, moved into place, and at the top
+/// level the scene material it gets.
+struct Copy {
+    ShapePointer shape;
+    std::uint32_t material = 0;
+    /// Whether the copy named its own material (an array's copy), over the node's.
+    bool has_own_material = false;
+};
+
+/// Whether `value` is a grid or an array node, which in a list stands for its copies.
+bool is_copies_node(const Json& value);
+
 class Loader {
 public:
     Loader(const Json& root, const Source& source) : root_(root), source_(source) {}
@@ -63,8 +75,10 @@ public:
     std::vector<ListItem> list(Fields& fields, std::string_view key, std::size_t minimum,
                                std::string_view of);
 
-    /// The copies of a grid node, each its item moved into place.
-    std::vector<ShapePointer> grid(Fields& fields);
+    /// The copies of a grid or array node (copies.cpp), each its item moved into place. At
+    /// the top level (`top_level`) each gets its material: the node's "material", its
+    /// "materials" cycled, its "material_ramp" blended, or an array copy's own "material".
+    std::vector<Copy> copies(Fields& fields, bool top_level);
 
     ShapePointer definition(const std::string& name, const std::string& pointer);
 
@@ -77,6 +91,14 @@ public:
     Transform transform(const Json& list, const std::string& pointer) const;
 
 private:
+    std::vector<Copy> grid(Fields& fields);
+    std::vector<Copy> array(Fields& fields, bool top_level);
+    /// Fails at `key` when `count` copies of `item` pass kMaxExpandedLeaves.
+    void require_copies_fit(Fields& fields, std::string_view key, std::size_t count,
+                            const Shape& item);
+    /// The index of the material called `name`, or a message at `key` listing the known ones.
+    std::uint32_t material_named(Fields& fields, std::string_view key, const std::string& name);
+
     void camera(Scene& scene);
     void materials(Scene& scene, std::map<std::string, std::uint32_t>& by_name);
     void lights(Scene& scene);
@@ -88,6 +110,9 @@ private:
 
     const Json& root_;
     const Source& source_;
+    /// The scene being loaded, and its materials by name.
+    Scene* scene_ = nullptr;
+    std::map<std::string, std::uint32_t> material_index_;
     const Json* definitions_ = nullptr;
     DefinitionIndex definition_index_;
     std::map<std::string, ShapePointer> built_;
@@ -112,6 +137,12 @@ std::string known_types();
 /// key the message names, when the node has that key, else at the node.
 [[noreturn]] void rethrow_invalid(const InvalidParameter& error, const Fields& fields,
                                   const Json& node, bool angles);
+
+/// Fails at `at` unless `transform` and its inverse are finite (transforms.cpp): a product of
+/// finite steps can overflow (scale 1e200 twice) or underflow, whose inverse then overflows
+/// (scale 1e-320). `product` says whether `transform` is a product of steps, for the message.
+void require_representable(const Transform& transform, const Source& source, const std::string& at,
+                           bool product);
 
 /// `shape` placed by `world_from_object`; nested instances are folded into one.
 ShapePointer place(ShapePointer shape, const Transform& world_from_object);

@@ -56,6 +56,13 @@ std::string child_pointer(const std::string& pointer, std::size_t index) {
     return pointer + "/" + std::to_string(index);
 }
 
+std::string with_article(std::string_view noun) {
+    const bool vowel =
+        !noun.empty() && std::string_view("aeiou").find(noun[0]) != std::string_view::npos;
+    std::string text = vowel ? "an " : "a ";
+    return text.append(shown(noun));
+}
+
 std::string describe(const Json& value) {
     switch (value.type()) {
         case Json::value_t::null:

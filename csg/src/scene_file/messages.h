@@ -30,6 +30,9 @@ std::string escape_pointer_token(std::string_view token);
 std::string child_pointer(const std::string& pointer, std::string_view key);
 std::string child_pointer(const std::string& pointer, std::size_t index);
 
+/// `noun` after "a" or "an" ("a sphere", "an array"), for what a node is in a message.
+std::string with_article(std::string_view noun);
+
 /// A JSON value in a few words, for "expected ..., got ..." messages.
 std::string describe(const Json& value);
 

@@ -2,6 +2,7 @@
 
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
+#include "csgrt/csg/complement.h"
 #include "csgrt/csg/compound.h"
 #include "csgrt/csg/ready_made.h"
 #include "csgrt/csg/scene_file.h"
@@ -16,7 +17,8 @@ std::string solid_requirement(const ListItem& item) {
     std::string kind(item.shape->kind());
     if (kind == "mesh") kind = "an open mesh (one with a boundary, not a closed surface)";
     return "expected a solid (a closed shape: sphere, box, capped cylinder or cone, torus, "
-           "boolean, ready-made solid, compound of solids, closed mesh) as a boolean operand, "
+           "half_space, boolean, not, ready-made solid, compound of solids, closed mesh) as a "
+           "boolean operand, "
            "got " +
            kind;
 }
@@ -36,6 +38,13 @@ std::vector<ShapePointer> plain_shapes(const std::vector<ListItem>& items) {
     return shapes;
 }
 
+std::vector<ShapePointer> copy_shapes(std::vector<Copy> copies) {
+    std::vector<ShapePointer> shapes;
+    shapes.reserve(copies.size());
+    for (Copy& copy : copies) shapes.push_back(std::move(copy.shape));
+    return shapes;
+}
+
 CompoundConfig compound_config(Fields& fields) {
     CompoundConfig config;
     config.accelerator = fields.string("accelerator", "auto");
@@ -52,6 +61,11 @@ const ShapeEntry kShapeTable[] = {
      [](Fields& f, Loader&) -> ShapePointer {
          const Point3 point = f.vector("point", Point3::Zero());
          return std::make_shared<Plane>(point, f.vector("normal"));
+     }},
+    {"half_space",
+     [](Fields& f, Loader&) -> ShapePointer {
+         const Point3 point = f.vector("point", Point3::Zero());
+         return std::make_shared<HalfSpace>(point, f.vector("normal"));
      }},
     {"triangle",
      [](Fields& f, Loader&) -> ShapePointer {
@@ -197,8 +211,20 @@ const ShapeEntry kShapeTable[] = {
     {"grid",
      [](Fields& f, Loader& loader) -> ShapePointer {
          // Outside a list a grid is one shape: the compound of its copies.
-         auto copies = loader.grid(f);
-         return std::make_shared<Compound>(std::move(copies), compound_config(f));
+         return std::make_shared<Compound>(copy_shapes(loader.copies(f, false)),
+                                           compound_config(f));
+     }},
+    {"array",
+     [](Fields& f, Loader& loader) -> ShapePointer {
+         return std::make_shared<Compound>(copy_shapes(loader.copies(f, false)),
+                                           compound_config(f));
+     }},
+    {"not",
+     [](Fields& f, Loader& loader) -> ShapePointer {
+         ListItem operand{loader.shape(f.required("operand", "a solid shape node"),
+                                       f.pointer("operand"), "the operand of \"not\""),
+                          f.pointer("operand")};
+         return std::make_shared<Complement>(operand_shapes({operand}, loader.source()).front());
      }},
     {"ref",
      [](Fields& f, Loader& loader) -> ShapePointer {

@@ -3,10 +3,6 @@
 
 namespace csgrt::detail::scene_file {
 
-namespace {
-
-/// Fails at `at` unless `transform` and its inverse are finite: a product of finite steps can
-/// overflow (scale 1e200 twice) or underflow, whose inverse then overflows (scale 1e-320).
 void require_representable(const Transform& transform, const Source& source, const std::string& at,
                            bool product) {
     const bool forward = transform.linear().allFinite() && transform.translation().allFinite();
@@ -18,8 +14,6 @@ void require_representable(const Transform& transform, const Source& source, con
     source.fail(at, what + (forward ? " underflows: its inverse" : " overflows: it") +
                         " has a coefficient beyond the largest double (1.8e308)");
 }
-
-}  // namespace
 
 ShapePointer place(ShapePointer shape, const Transform& world_from_object) {
     if (world_from_object.is_identity()) return shape;

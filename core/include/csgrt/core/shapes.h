@@ -6,6 +6,7 @@
 #include "csgrt/core/cone.h"
 #include "csgrt/core/cylinder.h"
 #include "csgrt/core/disk.h"
+#include "csgrt/core/half_space.h"
 #include "csgrt/core/instance.h"
 #include "csgrt/core/part_cylinder.h"
 #include "csgrt/core/part_sphere.h"
