@@ -108,6 +108,12 @@ TEST(SceneFileLimits, AGridPiledCloserThanItsItemIsRefusedAtItsCount) {
         << message;
     // Spacing 0 makes exact repeats, which cost one test.
     EXPECT_EQ(error_of(grid("0")), "no error");
+    // An item that can never be hit (its box is empty) piles up nothing.
+    EXPECT_EQ(error_of(R"({"objects": [{"type": "grid", "count": [30, 30, 30], "spacing": )"
+                       R"([1e-9, 1e-9, 1e-9], "item": {"type": "intersection", "operands": [)"
+                       R"({"type": "sphere", "radius": 1}, {"type": "sphere", "center": )"
+                       R"([5, 0, 0], "radius": 1}]}}]})"),
+              "no error");
 }
 
 /// `count` unit spheres as top-level objects: centres `step` apart along x, or, when

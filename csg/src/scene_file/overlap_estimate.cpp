@@ -93,6 +93,8 @@ Overlap overlapping_leaves(std::span<const Shape* const> members, bool drops_rep
 }
 
 std::uint64_t grid_overlap(const std::size_t counts[3], const Vector3& spacing, const Aabb& item) {
+    // An item that can never be hit (a disjoint intersection) piles up nothing.
+    if (item.is_empty()) return 1;
     std::uint64_t copies = 1;
     for (int axis = 0; axis < 3; ++axis) {
         // Zero spacing along an axis makes its copies exact repeats of one another.
@@ -102,7 +104,8 @@ std::uint64_t grid_overlap(const std::size_t counts[3], const Vector3& spacing, 
         const double along = std::isfinite(extent)
                                  ? std::floor(extent / std::abs(spacing[axis])) + 1
                                  : static_cast<double>(counts[axis]);
-        copies *= static_cast<std::uint64_t>(std::min(along, static_cast<double>(counts[axis])));
+        copies *=
+            static_cast<std::uint64_t>(std::clamp(along, 1.0, static_cast<double>(counts[axis])));
     }
     return copies;
 }
