@@ -57,32 +57,32 @@ Placement placement_of(const Shape* member) {
 }  // namespace
 
 std::vector<bool> exact_repeats(std::span<const Shape* const> members) {
-    // Sorted by hash, then placement, then index: equal placements end up side by side with
-    // the first of them leading, in O(n log n) whatever the input (a hash set would allocate
-    // per member, and runs of equal hashes would compare in pairs).
-    struct Keyed {
-        std::size_t hash;
-        Placement placement;
-        std::size_t index;
-    };
-    std::vector<Keyed> keyed;
-    keyed.reserve(members.size());
+    // Member indices sorted by hash, then placement, then index: equal placements end up side
+    // by side with the first of them leading, in O(n log n) whatever the input (a hash set would
+    // allocate per member, and runs of equal hashes would compare in pairs). Indices, not
+    // placements, are moved: a scene commits 10^6 members.
+    std::vector<Placement> placements(members.size());
+    std::vector<std::size_t> hashes(members.size());
+    std::vector<std::size_t> order;
+    order.reserve(members.size());
     for (std::size_t i = 0; i < members.size(); ++i) {
         if (members[i] == nullptr) continue;
-        const Placement placement = placement_of(members[i]);
-        keyed.push_back({hash_of(placement), placement, i});
+        placements[i] = placement_of(members[i]);
+        hashes[i] = hash_of(placements[i]);
+        order.push_back(i);
     }
-    std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
-        if (a.hash != b.hash) return a.hash < b.hash;
-        if (a.placement.shape != b.placement.shape)
-            return std::less<const Shape*>()(a.placement.shape, b.placement.shape);
-        if (a.placement.matrix != b.placement.matrix)
-            return a.placement.matrix < b.placement.matrix;
-        return a.index < b.index;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        if (hashes[a] != hashes[b]) return hashes[a] < hashes[b];
+        const Placement& first = placements[a];
+        const Placement& second = placements[b];
+        if (first.shape != second.shape)
+            return std::less<const Shape*>()(first.shape, second.shape);
+        if (first.matrix != second.matrix) return first.matrix < second.matrix;
+        return a < b;
     });
     std::vector<bool> repeats(members.size(), false);
-    for (std::size_t k = 1; k < keyed.size(); ++k) {
-        repeats[keyed[k].index] = keyed[k].placement == keyed[k - 1].placement;
+    for (std::size_t k = 1; k < order.size(); ++k) {
+        repeats[order[k]] = placements[order[k]] == placements[order[k - 1]];
     }
     return repeats;
 }
