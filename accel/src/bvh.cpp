@@ -590,6 +590,30 @@ struct BvhTraversal {
         float t_enter;
     };
 
+    /// The leaf (first, count) for each of a packet's rays in `rays` (bits), each with its own
+    /// leaf test and t_max: nearest hits into best and found, or occlusion into found, a ray
+    /// that is occluded leaving `open`.
+    template <bool kAny, class Lanes>
+    static void leaf_for_rays(const Tree& bvh, std::span<const Ray> packet, Lanes& lanes,
+                              std::uint32_t rays, std::uint32_t first, std::uint32_t count,
+                              HitRecord* best, bool* found, std::uint32_t& open,
+                              QueryScratch& scratch) {
+        TraversalCounters unused;
+        for (std::uint32_t m = rays; m != 0; m &= m - 1) {
+            const int r = std::countr_zero(m);
+            const auto& leaf_ray = lanes.leaf(r, *bvh.set_, packet[r], scratch);
+            if constexpr (kAny) {
+                if (occluded_in_leaf<false>(bvh, leaf_ray, first, count, unused)) {
+                    found[r] = true;
+                    open &= ~(1u << r);
+                }
+            } else {
+                found[r] |= nearest_in_leaf<false>(bvh, leaf_ray, first, count, best[r],
+                                                   lanes[r].t_max, unused);
+            }
+        }
+    }
+
     /// Traverses the wide tree once for up to kPacketRays rays: every node is tested against
     /// each ray that entered it, exactly as the single-ray traversal tests it (same node test,
     /// same t_max), and a ray enters a child only when its own test says so; a leaf is tested
@@ -687,20 +711,8 @@ struct BvhTraversal {
                 active = top->rays;
             }
             if (count != Node::kInterior && count != 0) {
-                for (std::uint32_t m = active; m != 0; m &= m - 1) {
-                    const int r = std::countr_zero(m);
-                    auto& lane = lanes[r];
-                    const auto& leaf_ray = lanes.leaf(r, *bvh.set_, rays[r], scratch);
-                    if constexpr (kAny) {
-                        if (occluded_in_leaf<false>(bvh, leaf_ray, first, count, unused)) {
-                            found[r] = true;
-                            open &= ~(1u << r);
-                        }
-                    } else {
-                        found[r] |= nearest_in_leaf<false>(bvh, leaf_ray, first, count, best[r],
-                                                           lane.t_max, unused);
-                    }
-                }
+                leaf_for_rays<kAny>(bvh, rays, lanes, active, first, count, best, found, open,
+                                    scratch);
                 if (open == 0) return;
             }
             // Each entry keeps the rays still open whose own entry may lie within their t_max
@@ -802,19 +814,7 @@ struct BvhTraversal {
             }
         }
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
-            for (std::uint32_t m = open; m != 0; m &= m - 1) {
-                const int r = std::countr_zero(m);
-                const auto& leaf_ray = lanes.leaf(r, *bvh.set_, rays[r], scratch);
-                if constexpr (kAny) {
-                    if (occluded_in_leaf<false>(bvh, leaf_ray, first, count, unused)) {
-                        found[r] = true;
-                        open &= ~(1u << r);
-                    }
-                } else {
-                    found[r] |= nearest_in_leaf<false>(bvh, leaf_ray, first, count, best[r],
-                                                       lanes[r].t_max, unused);
-                }
-            }
+            leaf_for_rays<kAny>(bvh, rays, lanes, open, first, count, best, found, open, scratch);
             t_max = largest_t_max();
             return open == 0;
         };

@@ -123,6 +123,50 @@ struct BlockRay {
 };
 
 #if CSGRT_BVH_AVX2
+/// Eight lanes of TriangleSet<float>'s test at once (eight triangles against one ray, or one
+/// triangle against eight rays): the corners' coordinates on the test's axes relative to the
+/// origin, sheared, and the edge functions, with the float operations of TriangleSet::shear
+/// and hit_sheared lane by lane (no fused multiply-add), so each lane holds the scalar test's
+/// bits.
+struct Avx2ShearedLanes {
+    __m256 x[3], y[3], z[3], u, v, w;
+    /// Lanes with an edge function that is exactly zero (hit_sheared recomputes those).
+    unsigned zeros;
+
+    /// corners[k][a]: corner k on the test's axis a (x, y, z), lane by lane.
+    [[gnu::target("avx2")]] Avx2ShearedLanes(const __m256 (&corners)[3][3],
+                                             const __m256 (&origin)[3], __m256 shear_x,
+                                             __m256 shear_y) {
+        for (int k = 0; k < 3; ++k) {
+            const __m256 px = _mm256_sub_ps(corners[k][0], origin[0]);
+            const __m256 py = _mm256_sub_ps(corners[k][1], origin[1]);
+            const __m256 pz = _mm256_sub_ps(corners[k][2], origin[2]);
+            x[k] = _mm256_sub_ps(px, _mm256_mul_ps(shear_x, pz));
+            y[k] = _mm256_sub_ps(py, _mm256_mul_ps(shear_y, pz));
+            z[k] = pz;
+        }
+        u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
+        v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
+        w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
+        const __m256 zero = _mm256_setzero_ps();
+        zeros = static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(
+            _mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
+            _mm256_cmp_ps(w, zero, _CMP_EQ_OQ))));
+    }
+
+    /// The lanes that may hit: as BlockRay::candidates, a lane is dropped only when its edge
+    /// functions are non-zero and of mixed signs (read off their sign bits).
+    [[gnu::target("avx2")]] unsigned candidates() const {
+        const unsigned some_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(u, v), w)));
+        const unsigned all_negative =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(u, v), w)));
+        return (zeros | ~(some_negative & ~all_negative)) & 0xffu;
+    }
+};
+#endif
+
+#if CSGRT_BVH_AVX2
 /// BlockRay::candidates on two consecutive blocks at once, lanes 0-3 the first and 4-7 the
 /// second, in 8-lane AVX2 steps: the same operations lane by lane (no fused multiply-add), so
 /// the same bits. Most leaves hold five to eight triangles, two blocks.
@@ -155,36 +199,22 @@ struct alignas(32) Avx2BlockRay {
     [[gnu::target("avx2")]] unsigned candidates(const BvhTriangleBlock& first,
                                                 const BvhTriangleBlock& second,
                                                 ShearedBlock (&sheared)[2], unsigned& zeros) const {
-        __m256 x[3], y[3], z[3];
+        __m256 corners[3][3];
         for (int k = 0; k < 3; ++k) {
-            const __m256 px = _mm256_sub_ps(load(first, second, k, axis[0]), origin[0]);
-            const __m256 py = _mm256_sub_ps(load(first, second, k, axis[1]), origin[1]);
-            const __m256 pz = _mm256_sub_ps(load(first, second, k, axis[2]), origin[2]);
-            x[k] = _mm256_sub_ps(px, _mm256_mul_ps(shear_x, pz));
-            y[k] = _mm256_sub_ps(py, _mm256_mul_ps(shear_y, pz));
-            z[k] = pz;
+            for (int a = 0; a < 3; ++a) corners[k][a] = load(first, second, k, axis[a]);
         }
-        const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
-        const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
-        const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
-        const __m256 zero = _mm256_setzero_ps();
-        zeros = static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(
-            _mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
-            _mm256_cmp_ps(w, zero, _CMP_EQ_OQ))));
-        const unsigned some_negative =
-            static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(u, v), w)));
-        const unsigned all_negative =
-            static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(u, v), w)));
-        const unsigned result = (zeros | ~(some_negative & ~all_negative)) & 0xffu;
+        const Avx2ShearedLanes lanes(corners, origin, shear_x, shear_y);
+        zeros = lanes.zeros;
+        const unsigned result = lanes.candidates();
         if (result != 0) {
             for (int k = 0; k < 3; ++k) {
-                split(x[k], sheared[0].x[k], sheared[1].x[k]);
-                split(y[k], sheared[0].y[k], sheared[1].y[k]);
-                split(z[k], sheared[0].z[k], sheared[1].z[k]);
+                split(lanes.x[k], sheared[0].x[k], sheared[1].x[k]);
+                split(lanes.y[k], sheared[0].y[k], sheared[1].y[k]);
+                split(lanes.z[k], sheared[0].z[k], sheared[1].z[k]);
             }
-            split(u, sheared[0].u, sheared[1].u);
-            split(v, sheared[0].v, sheared[1].v);
-            split(w, sheared[0].w, sheared[1].w);
+            split(lanes.u, sheared[0].u, sheared[1].u);
+            split(lanes.v, sheared[0].v, sheared[1].v);
+            split(lanes.w, sheared[0].w, sheared[1].w);
         }
         return result;
     }
@@ -231,35 +261,18 @@ struct alignas(32) PacketTriangleRays {
     /// are some, `sheared` holds every ray's sheared corners (x, y, z of corners 0, 1, 2).
     [[gnu::target("avx2")]] unsigned candidates(const BvhTriangleBlock& block, int lane,
                                                 unsigned rays, float (&sheared)[9][8]) const {
-        __m256 x[3], y[3], z[3];
+        __m256 corners[3][3];
         for (int k = 0; k < 3; ++k) {
-            const __m256 px =
-                _mm256_sub_ps(_mm256_set1_ps(block.corners[k][axis[0]][lane]), origin[0]);
-            const __m256 py =
-                _mm256_sub_ps(_mm256_set1_ps(block.corners[k][axis[1]][lane]), origin[1]);
-            const __m256 pz =
-                _mm256_sub_ps(_mm256_set1_ps(block.corners[k][axis[2]][lane]), origin[2]);
-            x[k] = _mm256_sub_ps(px, _mm256_mul_ps(shear_x, pz));
-            y[k] = _mm256_sub_ps(py, _mm256_mul_ps(shear_y, pz));
-            z[k] = pz;
+            for (int a = 0; a < 3; ++a)
+                corners[k][a] = _mm256_set1_ps(block.corners[k][axis[a]][lane]);
         }
-        const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
-        const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
-        const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
-        const __m256 zero = _mm256_setzero_ps();
-        const unsigned zeros = static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(
-            _mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
-            _mm256_cmp_ps(w, zero, _CMP_EQ_OQ))));
-        const unsigned some_negative =
-            static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(u, v), w)));
-        const unsigned all_negative =
-            static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(u, v), w)));
-        const unsigned result = (zeros | ~(some_negative & ~all_negative)) & rays;
+        const Avx2ShearedLanes lanes(corners, origin, shear_x, shear_y);
+        const unsigned result = lanes.candidates() & rays;
         if (result != 0) {
             for (int k = 0; k < 3; ++k) {
-                _mm256_store_ps(sheared[k], x[k]);
-                _mm256_store_ps(sheared[3 + k], y[k]);
-                _mm256_store_ps(sheared[6 + k], z[k]);
+                _mm256_store_ps(sheared[k], lanes.x[k]);
+                _mm256_store_ps(sheared[3 + k], lanes.y[k]);
+                _mm256_store_ps(sheared[6 + k], lanes.z[k]);
             }
         }
         return result;
