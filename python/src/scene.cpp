@@ -14,6 +14,7 @@
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
 #include "csgrt/csg/boolean.h"
+#include "csgrt/csg/complement.h"
 #include "csgrt/csg/compound.h"
 #include "csgrt/csg/scene_file.h"
 #include "csgrt/render/exr.h"
@@ -316,9 +317,12 @@ values it rejects, raise ValueError naming the parameter.
 )doc");
     for (const std::string_view type : scene_shape_types()) {
         if (type == "union" || type == "intersection" || type == "difference" ||
-            type == "compound" || type == "mesh" || type == "ref" || type == "grid") {
-            // Booleans, compounds and meshes take shapes or arrays (bound below); a scene
-            // file's references and grids name definitions, which Python holds as variables.
+            type == "compound" || type == "mesh" || type == "ref" || type == "grid" ||
+            type == "not" || type == "array") {
+            // Booleans, the complement ("not" is a Python keyword: csgrt.complement),
+            // compounds and meshes take shapes or arrays (bound below); a scene file's
+            // references, grids and arrays of copies name definitions, which Python holds as
+            // variables (and copies as a loop).
             continue;
         }
         const std::string name(type);
@@ -343,6 +347,14 @@ values it rejects, raise ValueError naming the parameter.
             return PyShape{make_difference(shape_of(first, "first"), shapes_of(args, "subtracted"))};
         },
         "first"_a, "The first solid minus every other one: difference(a, b, c) = a - (b | c).");
+    m.def(
+        "complement",
+        [](const py::object& operand) {
+            return PyShape{std::make_shared<Complement>(shape_of(operand, "operand"))};
+        },
+        "operand"_a,
+        "Everything outside a solid (the scene file's \"not\"), itself a solid: "
+        "intersection(a, complement(b)) is difference(a, b).");
     m.def(
         "compound",
         [](const py::list& children, const std::string& accelerator) {

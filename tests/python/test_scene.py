@@ -49,6 +49,23 @@ def test_sphere_hits_against_the_closed_form():
     np.testing.assert_array_equal(scene.compute_occupancy(middle), 1.0)
 
 
+def test_complement_in_an_intersection_is_the_difference():
+    # box ∩ not(sphere) holds exactly the points of the box outside the sphere.
+    scene = csgrt.Scene()
+    cut = csgrt.intersection(csgrt.box(lower=[-1, -1, -1], upper=[1, 1, 1]),
+                             csgrt.complement(csgrt.sphere(center=[1, 1, 1], radius=1)))
+    assert cut.is_solid
+    scene.add_object(cut)
+    scene.commit()
+    rng = np.random.default_rng(12)
+    points = rng.uniform(-1.5, 1.5, size=(4000, 3))
+    expected = np.all(np.abs(points) < 1, axis=1) & (np.linalg.norm(points - 1, axis=1) > 1)
+    np.testing.assert_array_equal(scene.compute_occupancy(points), expected.astype(np.float32))
+    assert not hasattr(csgrt, "array")
+    with pytest.raises((TypeError, ValueError)):
+        csgrt.complement(42)
+
+
 def test_csg_difference_and_instances_against_membership():
     scene = csgrt.Scene()
     bitten = csgrt.difference(csgrt.box(lower=[-1, -1, -1], upper=[1, 1, 1]),
