@@ -9,9 +9,8 @@
 #include <algorithm>
 #include <string>
 
-#include "csgrt/accel/bvh.h"
-#include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
+#include "ray_packet.h"
 
 namespace csgrt {
 
@@ -43,64 +42,6 @@ void check_rays(const RayArrays<Real>& rays) {
 /// threads, each thread with its own scratch. Every index is handled by exactly one call and
 /// what a call writes depends only on its indices, so the answers are the same for any
 /// thread count and any split.
-/// The rays of a block taken Bvh::kPacketRays at a time through the BVH's packet queries
-/// (which answer as the single-ray queries do, bit for bit, and walk rays with one origin,
-/// camera rays, as one), or one at a time through any other structure. A packet is traced
-/// when one of its rays is first asked for.
-class RayPacket {
-public:
-    template <class Real, class SetReal>
-    const HitRecord* nearest(const Bvh<TriangleSet<SetReal>>* bvh,
-                             const Accelerator<TriangleSet<SetReal>>& structure,
-                             const RayArrays<Real>& rays, std::size_t i, std::size_t end,
-                             QueryScratch& scratch) {
-        if (!holds(i)) {
-            start(rays, i, end);
-            if (bvh != nullptr) {
-                bvh->intersect_packets({rays_, size_}, {records_, size_}, {hit_, size_}, scratch);
-            } else {
-                for (std::size_t k = 0; k < size_; ++k)
-                    hit_[k] = structure.intersect(rays_[k], records_[k], scratch);
-            }
-        }
-        return hit_[i - first_] ? &records_[i - first_] : nullptr;
-    }
-    template <class Real, class SetReal>
-    bool occluded(const Bvh<TriangleSet<SetReal>>* bvh,
-                  const Accelerator<TriangleSet<SetReal>>& structure, const RayArrays<Real>& rays,
-                  std::size_t i, std::size_t end, QueryScratch& scratch) {
-        if (!holds(i)) {
-            start(rays, i, end);
-            if (bvh != nullptr) {
-                bvh->occluded_packets({rays_, size_}, {hit_, size_}, scratch);
-            } else {
-                for (std::size_t k = 0; k < size_; ++k)
-                    hit_[k] = structure.occluded(rays_[k], scratch);
-            }
-        }
-        return hit_[i - first_];
-    }
-
-private:
-    static constexpr std::size_t kRays = 8;
-
-    bool holds(std::size_t i) const { return i >= first_ && i - first_ < size_; }
-
-    /// Packets are aligned to multiples of kRays in the whole batch, so the same rays travel
-    /// together whatever the blocks are (the answers do not depend on it either way).
-    template <class Real>
-    void start(const RayArrays<Real>& rays, std::size_t i, std::size_t end) {
-        first_ = i;
-        size_ = std::min(kRays - i % kRays, end - i);
-        for (std::size_t k = 0; k < size_; ++k) rays_[k] = rays.ray(i + k);
-    }
-
-    Ray rays_[kRays];
-    HitRecord records_[kRays];
-    bool hit_[kRays] = {};
-    std::size_t first_ = static_cast<std::size_t>(-1), size_ = 0;
-};
-
 template <class Body>
 void for_blocks(std::size_t count, const BatchConfig& config, const Body& body) {
     if (count == 0) return;
@@ -342,7 +283,7 @@ void intersect(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& ra
     const bool wants_ids = !outputs.object_id.empty() || !outputs.primitive_id.empty();
     const auto* bvh = dynamic_cast<const Bvh<TriangleSet<SetReal>>*>(mesh.structure);
     for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        RayPacket packet;
+        detail::RayPacket packet;
         for (std::size_t i = begin; i < end; ++i) {
             const HitRecord* found = packet.nearest(bvh, *mesh.structure, rays, i, end, s);
             if (found == nullptr) {
@@ -387,7 +328,7 @@ void occluded(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& ray
     check_size(occluded.size(), rays.size(), "occluded");
     const auto* bvh = dynamic_cast<const Bvh<TriangleSet<SetReal>>*>(mesh.structure);
     for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        RayPacket packet;
+        detail::RayPacket packet;
         for (std::size_t i = begin; i < end; ++i) {
             occluded[i] = packet.occluded(bvh, *mesh.structure, rays, i, end, s);
         }
