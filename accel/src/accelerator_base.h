@@ -4,8 +4,32 @@
 // sources only: each instantiates them once, beside the query they call.
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/core/query_cost.h"
 
 namespace csgrt {
+
+namespace detail {
+
+/// An uncounted query made while a CostScope is open on its scratch (a structure inside a mesh
+/// or a compound, reached from a counted query): the counted query, its work added to the
+/// scratch's cost. Kept out of line so the uncounted query's code stays as it was.
+template <QueryKind kKind, class Base>
+[[gnu::noinline]] bool query_into_cost(const Base& structure, const Ray& ray,
+                                       QueryAnswer<kKind>& answer, QueryScratch& scratch) {
+    TraversalCounters counters;
+    bool found;
+    if constexpr (kKind == QueryKind::kNearest) {
+        found = structure.Base::intersect_counted(ray, answer, scratch, counters);
+    } else {
+        found = structure.Base::occluded_counted(ray, scratch, counters);
+    }
+    QueryCost* cost = scratch.cost();
+    cost->nodes += counters.nodes_visited;
+    cost->primitives += counters.primitives_tested;
+    return found;
+}
+
+}  // namespace detail
 
 template <class Derived, class Set>
 std::string_view AcceleratorBase<Derived, Set>::name() const {
@@ -15,14 +39,18 @@ std::string_view AcceleratorBase<Derived, Set>::name() const {
 template <class Derived, class Set>
 bool AcceleratorBase<Derived, Set>::intersect(const Ray& ray, HitRecord& record,
                                               QueryScratch& scratch) const {
+    if (scratch.cost() != nullptr) [[unlikely]]
+        return detail::query_into_cost<QueryKind::kNearest>(*this, ray, record, scratch);
     TraversalCounters unused;
     return derived().template query<QueryKind::kNearest, false>(ray, record, scratch, unused);
 }
 
 template <class Derived, class Set>
 bool AcceleratorBase<Derived, Set>::occluded(const Ray& ray, QueryScratch& scratch) const {
-    TraversalCounters unused;
     NoAnswer none;
+    if (scratch.cost() != nullptr) [[unlikely]]
+        return detail::query_into_cost<QueryKind::kAny>(*this, ray, none, scratch);
+    TraversalCounters unused;
     return derived().template query<QueryKind::kAny, false>(ray, none, scratch, unused);
 }
 

@@ -65,7 +65,8 @@ std::optional<Crossing> Box::crossing(const Ray& ray) const {
     return {};
 }
 
-void Box::find_spans(const Ray& ray, SpanList& spans, QueryScratch&) const {
+void Box::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
+    count_solve(scratch, *this);
     spans.clear();
     double t_enter, t_exit;
     int enter_face, exit_face;

@@ -179,7 +179,8 @@ std::optional<Crossing> Cone::crossing(const Ray& ray) const {
     return crossing;
 }
 
-void Cone::find_spans(const Ray& ray, SpanList& spans, QueryScratch&) const {
+void Cone::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
+    count_solve(scratch, *this);
     spans.clear();
     if (!capped_) return;
     const detail::LineInterval span = solid_interval(ray);

@@ -46,7 +46,8 @@ std::optional<Crossing> Cylinder::crossing(const Ray& ray) const {
     return {};
 }
 
-void Cylinder::find_spans(const Ray& ray, SpanList& spans, QueryScratch&) const {
+void Cylinder::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
+    count_solve(scratch, *this);
     spans.clear();
     if (!capped_) return;
     const detail::LineInterval span =

@@ -77,7 +77,8 @@ std::optional<Crossing> Sphere::crossing(const Ray& ray) const {
     return Crossing{.t = t};
 }
 
-void Sphere::find_spans(const Ray& ray, SpanList& spans, QueryScratch&) const {
+void Sphere::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
+    count_solve(scratch, *this);
     spans.clear();
     double t0, t1;
     if (!line_roots(ray, t0, t1) || t1 < ray.t_min || t0 > ray.t_max) return;

@@ -201,7 +201,8 @@ std::optional<Crossing> Torus::crossing(const Ray& ray) const {
     return {};
 }
 
-void Torus::find_spans(const Ray& ray, SpanList& spans, QueryScratch&) const {
+void Torus::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
+    count_solve(scratch, *this);
     spans.clear();
     double roots[4];
     const int count = line_roots(ray, roots);

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "csgrt/core/error.h"
+#include "csgrt/core/query_cost.h"
 
 namespace csgrt {
 
@@ -79,6 +80,7 @@ bool Boolean::operand_spans(const Ray& ray, const Vector3& inverse_direction, Sp
     covered.t_min = std::max(ray.t_min, first_spans.front().enter.t);
     covered.t_max = std::min(ray.t_max, first_spans.back().exit.t);
     if (!(covered.t_min <= covered.t_max)) return false;
+    count_box_tests(scratch, 1);
     if (box_hit(second_bounds_, covered, inverse_direction)) {
         second_->find_spans(covered, second_spans, scratch);
     }
@@ -87,8 +89,10 @@ bool Boolean::operand_spans(const Ray& ray, const Vector3& inverse_direction, Sp
 
 bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    count_box_tests(scratch, 1);
     if (!box_hit(bounds_, ray, inverse_direction)) return false;
     if (operation_ == BooleanOperation::Union) {
+        count_box_tests(scratch, 2);
         double first_t0, first_t1, second_t0, second_t1;
         const bool first_hit =
             box_interval(first_bounds_, ray, inverse_direction, first_t0, first_t1);
@@ -113,6 +117,7 @@ bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scrat
         return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray,
                                        record);
     }
+    if (operation_ == BooleanOperation::Difference) count_box_tests(scratch, 1);
     if (operation_ == BooleanOperation::Difference &&
         !box_hit(second_bounds_, ray, inverse_direction)) {
         return first_->nearest_hit(ray, record, scratch);
@@ -127,9 +132,11 @@ bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scrat
 
 bool Boolean::any_hit(const Ray& ray, QueryScratch& scratch) const {
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    count_box_tests(scratch, 1);
     if (!box_hit(bounds_, ray, inverse_direction)) return false;
     HitRecord record;
     if (operation_ == BooleanOperation::Union) {
+        count_box_tests(scratch, 2);
         double first_t0, first_t1, second_t0, second_t1;
         const bool first_hit =
             box_interval(first_bounds_, ray, inverse_direction, first_t0, first_t1);
@@ -148,6 +155,7 @@ bool Boolean::any_hit(const Ray& ray, QueryScratch& scratch) const {
         return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray,
                                        record);
     }
+    if (operation_ == BooleanOperation::Difference) count_box_tests(scratch, 1);
     if (operation_ == BooleanOperation::Difference &&
         !box_hit(second_bounds_, ray, inverse_direction)) {
         return first_->any_hit(ray, scratch);
@@ -163,8 +171,10 @@ bool Boolean::any_hit(const Ray& ray, QueryScratch& scratch) const {
 void Boolean::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
     spans.clear();
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    count_box_tests(scratch, 1);
     if (!box_hit(bounds_, ray, inverse_direction)) return;
     if (operation_ == BooleanOperation::Union) {
+        count_box_tests(scratch, 2);
         // The same decisions as nearest_hit, so that both report the same first end.
         const bool first_hit = box_hit(first_bounds_, ray, inverse_direction);
         const bool second_hit = box_hit(second_bounds_, ray, inverse_direction);
@@ -183,6 +193,7 @@ void Boolean::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch)
         combine_spans(operation_, first_spans.list(), second_spans.list(), ray, spans);
         return;
     }
+    if (operation_ == BooleanOperation::Difference) count_box_tests(scratch, 1);
     if (operation_ == BooleanOperation::Difference &&
         !box_hit(second_bounds_, ray, inverse_direction)) {
         first_->find_spans(ray, spans, scratch);

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "csgrt/core/error.h"
+#include "csgrt/core/query_cost.h"
 #include "csgrt/csg/span_combine.h"
 
 namespace csgrt {
@@ -55,12 +56,14 @@ AcceleratorStats Compound::accelerator_stats() const {
 
 bool Compound::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    if (group_.unbounded().empty()) count_box_tests(scratch, 1);
     if (group_.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
     return group_.nearest(ray, record, scratch);
 }
 
 bool Compound::any_hit(const Ray& ray, QueryScratch& scratch) const {
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    if (group_.unbounded().empty()) count_box_tests(scratch, 1);
     if (group_.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
     return group_.any(ray, scratch);
 }
@@ -69,6 +72,7 @@ void Compound::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch
     spans.clear();
     if (!solid_) return;
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
+    if (group_.unbounded().empty()) count_box_tests(scratch, 1);
     if (group_.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return;
     union_of_spans(ray, spans, scratch);
 }
@@ -81,6 +85,7 @@ void Compound::union_of_spans(const Ray& ray, SpanList& spans, QueryScratch& scr
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     const ShapeSet& bounded = group_.bounded();
     if (bounded.size() <= kLinearSpanChildren) {
+        count_box_tests(scratch, bounded.size());
         for (std::size_t i = 0; i < bounded.size(); ++i) {
             if (box_hit(bounded.bounds(i), ray, inverse_direction)) {
                 list.push_back(HitRecord{.object = group_.member_of(i)});

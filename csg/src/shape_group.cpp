@@ -8,6 +8,7 @@
 #include "csgrt/accel/factory.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
+#include "csgrt/core/query_cost.h"
 
 namespace csgrt {
 
@@ -138,6 +139,7 @@ bool ShapeGroup::nearest_impl(const Ray& ray, HitRecord& record, QueryScratch& s
         if (found) narrowed.t_max = best.t;
         HitRecord candidate;
         if constexpr (kCount) ++counters.primitives_tested;
+        if constexpr (!kCount) count_primitive_test(scratch);
         if (!unbounded_shapes_[k]->nearest_hit(narrowed, candidate, scratch)) continue;
         if (found && !(candidate.t < best.t || (candidate.t == best.t && index < best.object)))
             continue;
@@ -162,6 +164,7 @@ bool ShapeGroup::nearest_counted(const Ray& ray, HitRecord& record, QueryScratch
 bool ShapeGroup::any(const Ray& ray, QueryScratch& scratch) const {
     if (structure_->occluded(ray, scratch)) return true;
     for (const auto& shape : unbounded_shapes_) {
+        count_primitive_test(scratch);
         if (shape->any_hit(ray, scratch)) return true;
     }
     return false;
@@ -178,6 +181,7 @@ void ShapeGroup::all(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch&
     all_bounded(ray, hits, scratch);
     for (std::size_t k = 0; k < unbounded_.size(); ++k) {
         HitRecord candidate;
+        count_primitive_test(scratch);
         if (!unbounded_shapes_[k]->nearest_hit(ray, candidate, scratch)) continue;
         candidate.object = unbounded_[k];
         hits.push_back(candidate);

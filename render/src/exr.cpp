@@ -19,9 +19,11 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstddef>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -80,6 +82,9 @@ struct ChannelSpec {
     Imf::PixelType memory_type;
     std::size_t offset;
     double fill;
+    /// Read from files of earlier csgrt versions when the file lacks the channel that now
+    /// holds the value; never written.
+    bool legacy = false;
 };
 
 constexpr int kImagePart = 0;
@@ -90,7 +95,9 @@ const std::array<const char*, 2> kPartNames = {"rgba", "id"};
 // one reads as; the half channels come first, in the order of the write buffer. The id has a
 // part of its own: OpenImageIO gives a part one pixel type, and in a part of mixed types it
 // converts a uint channel to float normalised by 2^32 - 1, which loses the ids.
-const std::array<ChannelSpec, 10> kChannels = {{
+// The cost is the layer "cost" with one channel per count (Nuke's and OpenImageIO's
+// layer.channel rule: the last dot separates them); earlier files had one channel "cost".
+const std::array<ChannelSpec, 14> kChannels = {{
     {"R", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, red), 0.0},
     {"G", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, green), 0.0},
     {"B", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, blue), 0.0},
@@ -99,7 +106,11 @@ const std::array<ChannelSpec, 10> kChannels = {{
     {"N.X", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_x), 0.0},
     {"N.Y", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_y), 0.0},
     {"N.Z", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_z), 0.0},
-    {"cost", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost), 0.0},
+    {"cost.nodes", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost_nodes), 0.0},
+    {"cost.primitives", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost_primitives), 0.0},
+    {"cost.solves", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost_solves), 0.0},
+    {"cost.total", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost), 0.0},
+    {"cost", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost), 0.0, true},
     {"id", kIdPart, Imf::UINT, Imf::UINT, offsetof(Pixel, object_id), double(kNoIndex)},
 }};
 
@@ -141,8 +152,18 @@ Imf::IDManifest id_manifest(const ExrMetadata& metadata) {
     return manifest;
 }
 
+/// The names of a cost layer's channels, in Pixel's order: "cost.<structure>.nodes", ...
+std::array<std::string, 4> cost_layer_channels(const std::string& structure) {
+    const std::string prefix = "cost." + structure + ".";
+    return {prefix + "nodes", prefix + "primitives", prefix + "solves", prefix + "total"};
+}
+
+std::array<const std::vector<float>*, 4> channels_of(const CostLayer& layer) {
+    return {&layer.nodes, &layer.primitives, &layer.solves, &layer.total};
+}
+
 void write_exr_file(const std::filesystem::path& path, const Image& image,
-                    const ExrMetadata& metadata) {
+                    const ExrMetadata& metadata, std::span<const CostLayer> cost_layers) {
     std::vector<Imf::Header> headers(kPartNames.size(), Imf::Header(image.width(), image.height()));
     for (std::size_t part = 0; part < headers.size(); ++part) {
         headers[part].setName(kPartNames[part]);
@@ -150,6 +171,7 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
         headers[part].compression() = Imf::ZIP_COMPRESSION;
     }
     for (const ChannelSpec& channel : kChannels) {
+        if (channel.legacy) continue;
         headers[channel.part].channels().insert(channel.name, Imf::Channel(channel.file_type));
     }
     Imf::Header& header = headers[kImagePart];
@@ -175,6 +197,19 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
     }
     header.insert("samplesPerPixel", Imf::IntAttribute(metadata.samples_per_pixel));
     header.insert("scene", Imf::StringAttribute(metadata.scene));
+    // --cost-all: one layer per structure, its build time beside it (a timing, asked for).
+    for (const CostLayer& layer : cost_layers) {
+        if (layer.width != image.width() || layer.height != image.height()) {
+            throw std::runtime_error("cost layer '" + layer.structure + "' is " +
+                                     std::to_string(layer.width) + "x" +
+                                     std::to_string(layer.height) + ", not the image's size");
+        }
+        for (const std::string& name : cost_layer_channels(layer.structure)) {
+            header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+        }
+        header.insert("cost." + layer.structure + ".buildMilliseconds",
+                      Imf::DoubleAttribute(layer.build_milliseconds));
+    }
     Imf::addIDManifest(headers[kIdPart], Imf::CompressedIDManifest(id_manifest(metadata)));
 
     // OpenEXR converts pixel types when reading but not when writing: the colour channels go
@@ -190,6 +225,7 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
     const std::size_t colour_row = sizeof(colour[0]) * static_cast<std::size_t>(image.width());
     for (std::size_t c = 0; c < kChannels.size(); ++c) {
         const ChannelSpec& channel = kChannels[c];
+        if (channel.legacy) continue;
         Imf::FrameBuffer& frame_buffer = frame_buffers[channel.part];
         if (channel.file_type == Imf::HALF) {
             char* channel_base = reinterpret_cast<char*>(colour.data()) + c * sizeof(half);
@@ -199,6 +235,16 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
             frame_buffer.insert(channel.name, Imf::Slice(channel.file_type,
                                                          const_cast<char*>(base + channel.offset),
                                                          sizeof(Pixel), row));
+        }
+    }
+    const std::size_t float_row = sizeof(float) * static_cast<std::size_t>(image.width());
+    for (const CostLayer& layer : cost_layers) {
+        const std::array<std::string, 4> names = cost_layer_channels(layer.structure);
+        const auto channels = channels_of(layer);
+        for (std::size_t c = 0; c < names.size(); ++c) {
+            char* data = reinterpret_cast<char*>(const_cast<float*>(channels[c]->data()));
+            frame_buffers[kImagePart].insert(
+                names[c], Imf::Slice(Imf::FLOAT, data, sizeof(float), float_row));
         }
     }
     // OpenEXR zips its 16-line chunks on its own thread pool when it has one; without, a 2048^2
@@ -220,6 +266,44 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
     }
 }
 
+/// The --cost-all layers of the first part: every channel "cost.<structure>.total" names one.
+void read_cost_layers(Imf::MultiPartInputFile& file, ExrFile& result) {
+    const Imf::Header& header = file.header(0);
+    const int width = result.image.width();
+    const int height = result.image.height();
+    const std::string suffix = ".total";
+    Imf::FrameBuffer frame_buffer;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+        const std::string name = it.name();
+        if (!name.starts_with("cost.") || !name.ends_with(suffix) || name == "cost.total") continue;
+        CostLayer layer;
+        layer.structure = name.substr(5, name.size() - 5 - suffix.size());
+        layer.width = width;
+        layer.height = height;
+        if (const auto* built = header.findTypedAttribute<Imf::DoubleAttribute>(
+                "cost." + layer.structure + ".buildMilliseconds")) {
+            layer.build_milliseconds = built->value();
+        }
+        result.cost_layers.push_back(std::move(layer));
+    }
+    const Imath::Box2i window = header.dataWindow();
+    for (CostLayer& layer : result.cost_layers) {
+        const std::array<std::string, 4> names = cost_layer_channels(layer.structure);
+        const std::array<std::vector<float>*, 4> channels = {&layer.nodes, &layer.primitives,
+                                                             &layer.solves, &layer.total};
+        for (std::size_t c = 0; c < names.size(); ++c) {
+            channels[c]->assign(std::size_t(width) * std::size_t(height), 0.0f);
+            if (!header.channels().findChannel(names[c])) continue;
+            frame_buffer.insert(names[c], Imf::Slice::Make(Imf::FLOAT, channels[c]->data(), window,
+                                                           sizeof(float), sizeof(float) * width));
+        }
+    }
+    if (result.cost_layers.empty()) return;
+    Imf::InputPart input(file, 0);
+    input.setFrameBuffer(frame_buffer);
+    input.readPixels(window.min.y, window.max.y);
+}
+
 template <class Attribute, class Value>
 void read_attribute(const Imf::Header& header, const char* name, Value& value) {
     if (const auto* attribute = header.findTypedAttribute<Attribute>(name)) {
@@ -229,10 +313,11 @@ void read_attribute(const Imf::Header& header, const char* name, Value& value) {
 
 }  // namespace
 
-void write_exr(const std::filesystem::path& path, const Image& image, const ExrMetadata& metadata) {
+void write_exr(const std::filesystem::path& path, const Image& image, const ExrMetadata& metadata,
+               std::span<const CostLayer> cost_layers) {
     TemporaryFile temporary(path);
     try {
-        write_exr_file(temporary.path(), image, metadata);
+        write_exr_file(temporary.path(), image, metadata, cost_layers);
     } catch (const std::exception& error) {
         throw std::runtime_error("cannot write '" + path.string() + "': " + error.what());
     }
@@ -245,7 +330,8 @@ ExrFile read_exr(const std::filesystem::path& path) {
         // Earlier csgrt files are one part; the channels are looked up by name in every part.
         const Imf::Header& header = file.header(0);
         const Imath::Box2i window = header.dataWindow();
-        ExrFile result{Image(window.max.x - window.min.x + 1, window.max.y - window.min.y + 1), {}};
+        ExrFile result{
+            Image(window.max.x - window.min.x + 1, window.max.y - window.min.y + 1), {}, {}};
         char* base = reinterpret_cast<char*>(result.image.pixels().data());
         const std::size_t row = sizeof(Pixel) * static_cast<std::size_t>(result.image.width());
         std::vector<bool> found(kChannels.size(), false);
@@ -255,6 +341,13 @@ ExrFile read_exr(const std::filesystem::path& path) {
             for (std::size_t c = 0; c < kChannels.size(); ++c) {
                 const ChannelSpec& channel = kChannels[c];
                 if (found[c] || !file.header(part).channels().findChannel(channel.name)) continue;
+                if (channel.legacy &&
+                    std::any_of(kChannels.begin(), kChannels.end(),
+                                [&](const ChannelSpec& current) {
+                                    return !current.legacy && current.offset == channel.offset &&
+                                           file.header(part).channels().findChannel(current.name);
+                                }))
+                    continue;
                 found[c] = true;
                 frame_buffer.insert(channel.name,
                                     Imf::Slice::Make(channel.memory_type, base + channel.offset,
@@ -265,6 +358,7 @@ ExrFile read_exr(const std::filesystem::path& path) {
             input.readPixels(window.min.y, window.max.y);
         }
         // Channels no part has keep Pixel's defaults, which the Image already holds.
+        read_cost_layers(file, result);
 
         ExrMetadata& metadata = result.metadata;
         std::string projection;
@@ -339,29 +433,43 @@ std::filesystem::path cost_preview_path(const std::filesystem::path& exr_path) {
     return path.replace_extension(".cost.png");
 }
 
+std::filesystem::path cost_sheet_path(const std::filesystem::path& exr_path) {
+    std::filesystem::path path = exr_path;
+    return path.replace_extension(".cost-all.png");
+}
+
+std::vector<std::filesystem::path> render_file_paths(const std::filesystem::path& exr_path,
+                                                     bool with_cost_sheet) {
+    std::vector<std::filesystem::path> paths = {exr_path, colour_preview_path(exr_path),
+                                                cost_preview_path(exr_path)};
+    if (with_cost_sheet) paths.push_back(cost_sheet_path(exr_path));
+    return paths;
+}
+
 void write_render_files(const std::filesystem::path& exr_path, const Image& image,
-                        const ExrMetadata& metadata, const ToneMapping& tone_mapping) {
+                        const ExrMetadata& metadata, const ToneMapping& tone_mapping,
+                        std::span<const CostLayer> cost_layers) {
     // A target that is a directory would fail only at its rename, after the others had been
-    // replaced: check all three first.
-    for (const auto& target :
-         {exr_path, colour_preview_path(exr_path), cost_preview_path(exr_path)}) {
+    // replaced: check them all first.
+    const std::vector<std::filesystem::path> targets =
+        render_file_paths(exr_path, !cost_layers.empty());
+    for (const auto& target : targets) {
         if (std::filesystem::is_directory(target)) {
             throw std::runtime_error("cannot write '" + target.string() + "': is a directory");
         }
     }
-    TemporaryFile exr(exr_path);
-    TemporaryFile colour(colour_preview_path(exr_path));
-    TemporaryFile cost(cost_preview_path(exr_path));
+    std::vector<std::unique_ptr<TemporaryFile>> temporaries;
+    for (const auto& target : targets)
+        temporaries.push_back(std::make_unique<TemporaryFile>(target));
     try {
-        write_exr_file(exr.path(), image, metadata);
-        write_colour_png(colour.path(), image, tone_mapping);
-        write_cost_png(cost.path(), image);
+        write_exr_file(temporaries[0]->path(), image, metadata, cost_layers);
+        write_colour_png(temporaries[1]->path(), image, tone_mapping);
+        write_cost_png(temporaries[2]->path(), image);
+        if (!cost_layers.empty()) write_cost_sheet_png(temporaries[3]->path(), cost_layers);
     } catch (const std::exception& error) {
         throw std::runtime_error("cannot write '" + exr_path.string() + "': " + error.what());
     }
-    exr.commit();
-    colour.commit();
-    cost.commit();
+    for (const auto& temporary : temporaries) temporary->commit();
 }
 
 }  // namespace csgrt

@@ -63,8 +63,7 @@ int light_sample_count(const Light& light) {
     return 1;
 }
 
-std::optional<LightSample> sample_light(const Light& light, const Point3& point,
-                                        const Vector2& u) {
+std::optional<LightSample> sample_light(const Light& light, const Point3& point, const Vector2& u) {
     if (const auto* rectangle = std::get_if<RectangleLight>(&light)) {
         const Vector3 cross = rectangle->edge_u.cross(rectangle->edge_v);
         const double area = cross.norm();
@@ -103,8 +102,7 @@ std::optional<LightSample> sample_light(const Light& light, const Point3& point,
         Vector3 t2;
         orthonormal_basis(axis, t1, t2);
         const Vector3 to_light =
-            (cos_theta * axis + sin_theta * (std::cos(phi) * t1 + std::sin(phi) * t2))
-                .normalized();
+            (cos_theta * axis + sin_theta * (std::cos(phi) * t1 + std::sin(phi) * t2)).normalized();
         // The nearer root of |point + s to_light - centre| = r, clamped at the tangent.
         const double along = to_light.dot(offset);
         const double across2 = std::max(0.0, radius_squared - (distance_squared - along * along));

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -119,7 +119,7 @@ struct Glyph {
     std::array<std::uint8_t, 7> rows;
 };
 
-constexpr std::array<Glyph, 13> kGlyphs = {{
+constexpr std::array<Glyph, 39> kGlyphs = {{
     {'0', {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}},
     {'1', {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E}},
     {'2', {0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F}},
@@ -131,8 +131,35 @@ constexpr std::array<Glyph, 13> kGlyphs = {{
     {'8', {0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E}},
     {'9', {0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C}},
     {'.', {0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C}},
-    {'k', {0x10, 0x10, 0x12, 0x14, 0x18, 0x14, 0x12}},
     {'M', {0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11}},
+    {'-', {0x00, 0x00, 0x00, 0x1F, 0x00, 0x00, 0x00}},
+    // Lower case, for the contact sheet's structure names (no descenders: 7 rows).
+    {'a', {0x00, 0x00, 0x0E, 0x01, 0x0F, 0x11, 0x0F}},
+    {'b', {0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x1E}},
+    {'c', {0x00, 0x00, 0x0E, 0x10, 0x10, 0x11, 0x0E}},
+    {'d', {0x01, 0x01, 0x0D, 0x13, 0x11, 0x11, 0x0F}},
+    {'e', {0x00, 0x00, 0x0E, 0x11, 0x1F, 0x10, 0x0E}},
+    {'f', {0x06, 0x09, 0x08, 0x1C, 0x08, 0x08, 0x08}},
+    {'g', {0x00, 0x00, 0x0F, 0x11, 0x0F, 0x01, 0x0E}},
+    {'h', {0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x11}},
+    {'i', {0x04, 0x00, 0x0C, 0x04, 0x04, 0x04, 0x0E}},
+    {'j', {0x02, 0x00, 0x06, 0x02, 0x02, 0x12, 0x0C}},
+    {'k', {0x10, 0x10, 0x12, 0x14, 0x18, 0x14, 0x12}},
+    {'l', {0x0C, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E}},
+    {'m', {0x00, 0x00, 0x1A, 0x15, 0x15, 0x11, 0x11}},
+    {'n', {0x00, 0x00, 0x16, 0x19, 0x11, 0x11, 0x11}},
+    {'o', {0x00, 0x00, 0x0E, 0x11, 0x11, 0x11, 0x0E}},
+    {'p', {0x00, 0x00, 0x1E, 0x11, 0x1E, 0x10, 0x10}},
+    {'q', {0x00, 0x00, 0x0D, 0x13, 0x0F, 0x01, 0x01}},
+    {'r', {0x00, 0x00, 0x16, 0x19, 0x10, 0x10, 0x10}},
+    {'s', {0x00, 0x00, 0x0E, 0x10, 0x0E, 0x01, 0x1E}},
+    {'t', {0x08, 0x08, 0x1C, 0x08, 0x08, 0x09, 0x06}},
+    {'u', {0x00, 0x00, 0x11, 0x11, 0x11, 0x13, 0x0D}},
+    {'v', {0x00, 0x00, 0x11, 0x11, 0x11, 0x0A, 0x04}},
+    {'w', {0x00, 0x00, 0x11, 0x11, 0x15, 0x15, 0x0A}},
+    {'x', {0x00, 0x00, 0x11, 0x0A, 0x04, 0x0A, 0x11}},
+    {'y', {0x00, 0x00, 0x11, 0x11, 0x0F, 0x01, 0x0E}},
+    {'z', {0x00, 0x00, 0x1F, 0x02, 0x04, 0x08, 0x1F}},
 }};
 
 /// An RGB8 canvas that clips what is drawn outside it.
@@ -208,28 +235,18 @@ std::string cost_label(double value) {
     return text;
 }
 
-void write_cost_png(const std::filesystem::path& path, const Image& image) {
-    float max_cost = 0.0f;
-    for (const Pixel& pixel : image.pixels()) max_cost = std::max(max_cost, pixel.cost);
-    const int width = image.width();
-    const int strip = cost_scale_height(width);
-    const int height = image.height() + strip;
-    std::vector<std::uint8_t> rgb(3 * static_cast<std::size_t>(width) * height, 0);
-    Canvas canvas{width, height, rgb};
-    for (int y = 0; y < image.height(); ++y) {
-        for (int x = 0; x < width; ++x) {
-            const float cost = image.at(x, y).cost;
-            canvas.set(x, y, viridis8(max_cost > 0.0f ? double(cost) / max_cost : 0.0));
-        }
-    }
+namespace {
 
-    // The scale: a dark strip, the bar from 0 (left) to the largest cost (right), five ticks
-    // with their numbers, the outer two aligned to the bar's ends so that they stay in frame.
+/// Draws the scale strip (cost_scale_height(canvas.width) rows from `top`): a dark band, the
+/// colour bar from 0 (left) to `max_cost` (right), five ticks with their numbers, the outer two
+/// aligned to the bar's ends so that they stay in frame. On a `logarithmic` scale the bar's
+/// fraction t stands for the cost (1 + max_cost)^t - 1 (cost_fraction's inverse).
+void draw_cost_scale(Canvas& canvas, int top, float max_cost, bool logarithmic) {
+    const int width = canvas.width;
     const int unit = scale_unit(width);
     const std::array<std::uint8_t, 3> dark = {24, 24, 24};
     const std::array<std::uint8_t, 3> white = {235, 235, 235};
-    const int top = image.height();
-    canvas.fill(0, top, width, height, dark);
+    canvas.fill(0, top, width, top + cost_scale_height(width), dark);
     const int margin = std::min(3 * unit, std::max(0, (width - 2) / 2));
     const int bar_left = margin;
     const int bar_right = width - margin;  // exclusive
@@ -247,7 +264,8 @@ void write_cost_png(const std::filesystem::path& path, const Image& image) {
     for (int k : {0, 4, 2, 1, 3}) {
         const int x = bar_left + (bar_right - 1 - bar_left) * k / 4;
         canvas.fill(x - (unit - 1) / 2, tick_top, x + unit / 2 + 1, tick_top + 3 * unit, white);
-        const std::string label = cost_label(max_cost * k / 4.0);
+        const std::string label = cost_label(
+            logarithmic ? std::expm1(std::log1p(double(max_cost)) * k / 4.0) : max_cost * k / 4.0);
         const int text_width = static_cast<int>(label.size()) * 6 * unit - unit;
         int text_left = x - text_width / 2;
         if (k == 0) text_left = bar_left;
@@ -260,7 +278,92 @@ void write_cost_png(const std::filesystem::path& path, const Image& image) {
         written.emplace_back(text_left, text_right);
         canvas.text(text_left, text_top, label, unit, white);
     }
+}
+
+}  // namespace
+
+void write_cost_png(const std::filesystem::path& path, const Image& image) {
+    float max_cost = 0.0f;
+    for (const Pixel& pixel : image.pixels()) max_cost = std::max(max_cost, pixel.cost);
+    const int width = image.width();
+    const int height = image.height() + cost_scale_height(width);
+    std::vector<std::uint8_t> rgb(3 * static_cast<std::size_t>(width) * height, 0);
+    Canvas canvas{width, height, rgb};
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < width; ++x) {
+            const float cost = image.at(x, y).cost;
+            canvas.set(x, y, viridis8(max_cost > 0.0f ? double(cost) / max_cost : 0.0));
+        }
+    }
+    draw_cost_scale(canvas, image.height(), max_cost, false);
     write_rgb8(path, width, height, rgb);
+}
+
+double cost_fraction(double cost, double max_cost, bool logarithmic) {
+    if (!(max_cost > 0.0) || !(cost > 0.0)) return 0.0;
+    return logarithmic ? std::log1p(cost) / std::log1p(max_cost) : cost / max_cost;
+}
+
+CostSheetLayout cost_sheet_layout(int tiles, int tile_width, int tile_height) {
+    CostSheetLayout layout;
+    layout.columns = 1;
+    while (layout.columns * layout.columns < tiles) ++layout.columns;
+    layout.rows = tiles > 0 ? (tiles + layout.columns - 1) / layout.columns : 0;
+    const int provisional = layout.columns * tile_width;
+    const int unit = scale_unit(provisional);
+    layout.gap = 2 * unit;
+    layout.label_height = 11 * unit;
+    layout.width = layout.columns * tile_width + (layout.columns - 1) * layout.gap;
+    layout.scale_top = layout.rows * (layout.label_height + tile_height);
+    layout.height = layout.scale_top + cost_scale_height(layout.width);
+    return layout;
+}
+
+void write_cost_sheet_png(const std::filesystem::path& path, std::span<const CostLayer> layers) {
+    if (layers.empty())
+        throw std::runtime_error("cannot write '" + path.string() +
+                                 "': a contact sheet needs a cost layer");
+    const int tile_width = layers.front().width;
+    const int tile_height = layers.front().height;
+    float max_cost = 0.0f;
+    for (const CostLayer& layer : layers) {
+        if (layer.width != tile_width || layer.height != tile_height ||
+            layer.total.size() != std::size_t(tile_width) * std::size_t(tile_height)) {
+            throw std::runtime_error("cannot write '" + path.string() + "': cost layer '" +
+                                     layer.structure + "' differs in size from the first");
+        }
+        for (const float cost : layer.total) max_cost = std::max(max_cost, cost);
+    }
+    const CostSheetLayout layout =
+        cost_sheet_layout(static_cast<int>(layers.size()), tile_width, tile_height);
+    std::vector<std::uint8_t> rgb(3 * static_cast<std::size_t>(layout.width) * layout.height, 0);
+    Canvas canvas{layout.width, layout.height, rgb};
+    const std::array<std::uint8_t, 3> dark = {24, 24, 24};
+    const std::array<std::uint8_t, 3> white = {235, 235, 235};
+    canvas.fill(0, 0, layout.width, layout.scale_top, dark);
+    const int unit = layout.label_height / 11;
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+        const CostLayer& layer = layers[i];
+        const int left = static_cast<int>(i) % layout.columns * (tile_width + layout.gap);
+        const int top = static_cast<int>(i) / layout.columns * (layout.label_height + tile_height);
+        // The label: the structure and its build time, or the name alone when both do not fit.
+        char built[32];
+        std::snprintf(built, sizeof(built),
+                      layer.build_milliseconds < 100.0 ? " %.3g ms" : " %.0f ms",
+                      layer.build_milliseconds);
+        std::string label = layer.structure + built;
+        if (static_cast<int>(label.size()) * 6 * unit > tile_width) label = layer.structure;
+        canvas.text(left + unit, top + 2 * unit, label, unit, white);
+        for (int y = 0; y < tile_height; ++y) {
+            for (int x = 0; x < tile_width; ++x) {
+                const float cost = layer.total[std::size_t(y) * tile_width + x];
+                canvas.set(left + x, top + layout.label_height + y,
+                           viridis8(cost_fraction(cost, max_cost, true)));
+            }
+        }
+    }
+    draw_cost_scale(canvas, layout.scale_top, max_cost, true);
+    write_rgb8(path, layout.width, layout.height, rgb);
 }
 
 }  // namespace csgrt

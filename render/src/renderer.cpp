@@ -9,8 +9,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 
 #include "csgrt/core/error.h"
@@ -39,12 +41,17 @@ struct RayTally {
     std::uint64_t secondary_rays = 0;
     std::uint64_t primary_hits = 0;
     TraversalCounters centre_ray_work;
+    QueryCost centre_ray_cost;
     /// Sized to the scene's objects once per worker, so counting allocates nothing per ray.
     std::vector<std::uint64_t> hits_per_object;
+    /// Keyed by kind() literals; each map grows once per kind met, not per ray.
+    std::map<std::string_view, std::uint64_t> hits_by_leaf_kind;
+    std::map<std::string_view, std::uint64_t> solves_by_kind;
 
-    void count_hit(std::uint32_t object_id) {
+    void count_hit(const Hit& hit) {
         ++primary_hits;
-        if (object_id < hits_per_object.size()) ++hits_per_object[object_id];
+        if (hit.object_id < hits_per_object.size()) ++hits_per_object[hit.object_id];
+        if (hit.shape != nullptr) ++hits_by_leaf_kind[hit.shape->kind()];
     }
 };
 
@@ -189,14 +196,13 @@ Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryS
         const double reflectance =
             fresnel_dielectric(-direction.dot(normal), eta_incident, eta_transmitted);
         Vector3 radiance =
-            reflectance * trace(frame,
-                                spawned_ray(hit, geometric, reflect(direction, normal)),
+            reflectance * trace(frame, spawned_ray(hit, geometric, reflect(direction, normal)),
                                 scratch, tally, depth + 1);
         if (reflectance < 1.0) {
             if (const auto refracted = refract(direction, normal, eta_incident / eta_transmitted)) {
-                radiance += (1.0 - reflectance) *
-                            trace(frame, spawned_ray(hit, -geometric, *refracted), scratch,
-                                  tally, depth + 1);
+                radiance +=
+                    (1.0 - reflectance) * trace(frame, spawned_ray(hit, -geometric, *refracted),
+                                                scratch, tally, depth + 1);
             }
         }
         return radiance;
@@ -208,10 +214,27 @@ Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryS
         Normal3 normal = hit.shading_normal;
         if (normal.dot(geometric) < 0.0) normal = -normal;
         radiance += material.mirror.cwiseProduct(
-            trace(frame, spawned_ray(hit, geometric, reflect(direction, normal)), scratch,
-                  tally, depth + 1));
+            trace(frame, spawned_ray(hit, geometric, reflect(direction, normal)), scratch, tally,
+                  depth + 1));
     }
     return radiance;
+}
+
+/// The ray through the centre of pixel (x, y), traced with its work counted at every level:
+/// the top-level structure's in `counters`, everything below it by a cost scope, summed into
+/// `cost`.
+std::optional<Hit> trace_centre_ray(const Frame& frame, int x, int y, QueryScratch& scratch,
+                                    TraversalCounters& counters, QueryCost& cost) {
+    const Ray centre =
+        frame.film.ray((x + 0.5) / frame.settings.width, (y + 0.5) / frame.settings.height);
+    std::optional<Hit> hit;
+    {
+        const CostScope counting(scratch, cost);
+        hit = frame.scene.intersect_counted(centre, scratch, counters);
+    }
+    cost.nodes += counters.nodes_visited;
+    cost.primitives += counters.primitives_tested;
+    return hit;
 }
 
 void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& scratch,
@@ -220,16 +243,22 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
     const double width = settings.width;
     const double height = settings.height;
 
-    // The AOVs come from one counted ray through the pixel centre.
+    // The AOVs come from one ray through the pixel centre.
     const Ray centre = frame.film.ray((x + 0.5) / width, (y + 0.5) / height);
     TraversalCounters counters;
-    const std::optional<Hit> centre_hit = frame.scene.intersect_counted(centre, scratch, counters);
-    pixel.cost = static_cast<float>(counters.nodes_visited + counters.primitives_tested);
+    QueryCost cost;
+    cost.solves_by_kind = &tally.solves_by_kind;
+    const std::optional<Hit> centre_hit = trace_centre_ray(frame, x, y, scratch, counters, cost);
+    pixel.cost = static_cast<float>(cost.total());
+    pixel.cost_nodes = static_cast<float>(cost.nodes);
+    pixel.cost_primitives = static_cast<float>(cost.primitives);
+    pixel.cost_solves = static_cast<float>(cost.solves);
+    tally.centre_ray_cost += cost;
     tally.centre_ray_work.nodes_visited += counters.nodes_visited;
     tally.centre_ray_work.primitives_tested += counters.primitives_tested;
     tally.centre_ray_work.boxes_tested += counters.boxes_tested;
     if (centre_hit) {
-        tally.count_hit(centre_hit->object_id);
+        tally.count_hit(*centre_hit);
         pixel.depth = static_cast<float>(centre_hit->t);
         pixel.normal_x = static_cast<float>(centre_hit->shading_normal.x());
         pixel.normal_y = static_cast<float>(centre_hit->shading_normal.y());
@@ -256,7 +285,7 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
                 colour += background_of(frame);
                 continue;
             }
-            tally.count_hit(hit->object_id);
+            tally.count_hit(*hit);
             colour += shade_surface(frame, ray, *hit, scratch, tally, 0);
             ++covered;
         }
@@ -266,6 +295,43 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
     pixel.green = static_cast<float>(colour.y() * weight);
     pixel.blue = static_cast<float>(colour.z() * weight);
     pixel.alpha = static_cast<float>(covered * weight);
+}
+
+/// Calls visit(x, y, scratch, worker) for every pixel, in 16 x 16 tiles handed to
+/// settings.threads threads by oneTBB; each thread owns one QueryScratch and one `Worker` of
+/// `workers`, reused across its tiles. Reports progress after each tile.
+template <class Worker, class Visit>
+void for_each_pixel(const RenderSettings& settings,
+                    tbb::enumerable_thread_specific<Worker>& workers, Visit&& visit) {
+    const int tiles_x = (settings.width + settings.tile_size - 1) / settings.tile_size;
+    const int tiles_y = (settings.height + settings.tile_size - 1) / settings.tile_size;
+    const int tile_count = tiles_x * tiles_y;
+    tbb::enumerable_thread_specific<QueryScratch> scratches;
+    std::atomic<int> tiles_done{0};
+    auto render_tiles = [&](const tbb::blocked_range<int>& range) {
+        QueryScratch& scratch = scratches.local();
+        Worker& worker = workers.local();
+        for (int tile = range.begin(); tile != range.end(); ++tile) {
+            const int x0 = (tile % tiles_x) * settings.tile_size;
+            const int y0 = (tile / tiles_x) * settings.tile_size;
+            const int x1 = std::min(x0 + settings.tile_size, settings.width);
+            const int y1 = std::min(y0 + settings.tile_size, settings.height);
+            for (int y = y0; y < y1; ++y) {
+                for (int x = x0; x < x1; ++x) visit(x, y, scratch, worker);
+            }
+            const int done = ++tiles_done;
+            if (settings.progress) settings.progress(double(done) / tile_count);
+        }
+    };
+    // An explicit thread count may exceed the cores: the global control lets oneTBB start that
+    // many workers (the arena alone would be capped at the core count, with a warning).
+    std::optional<tbb::global_control> parallelism;
+    if (settings.threads > 0) {
+        parallelism.emplace(tbb::global_control::max_allowed_parallelism, settings.threads);
+    }
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    arena.execute(
+        [&] { tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), render_tiles); });
 }
 
 }  // namespace
@@ -300,44 +366,15 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
                       CameraFilm(scene.camera(), double(settings.width) / settings.height),
                       strata_for(settings.samples_per_pixel)};
 
-    const int tiles_x = (settings.width + settings.tile_size - 1) / settings.tile_size;
-    const int tiles_y = (settings.height + settings.tile_size - 1) / settings.tile_size;
-    const int tile_count = tiles_x * tiles_y;
-    // One scratch and one tally per worker thread, reused across its tiles.
-    tbb::enumerable_thread_specific<QueryScratch> scratches;
+    // One tally per worker thread, reused across its tiles.
     tbb::enumerable_thread_specific<RayTally> tallies([&scene] {
         RayTally tally;
         tally.hits_per_object.assign(scene.objects().size(), 0);
         return tally;
     });
-    std::atomic<int> tiles_done{0};
-
-    auto render_tiles = [&](const tbb::blocked_range<int>& range) {
-        QueryScratch& scratch = scratches.local();
-        RayTally& tally = tallies.local();
-        for (int tile = range.begin(); tile != range.end(); ++tile) {
-            const int x0 = (tile % tiles_x) * settings.tile_size;
-            const int y0 = (tile / tiles_x) * settings.tile_size;
-            const int x1 = std::min(x0 + settings.tile_size, settings.width);
-            const int y1 = std::min(y0 + settings.tile_size, settings.height);
-            for (int y = y0; y < y1; ++y) {
-                for (int x = x0; x < x1; ++x) {
-                    render_pixel(frame, x, y, result.image.at(x, y), scratch, tally);
-                }
-            }
-            const int done = ++tiles_done;
-            if (settings.progress) settings.progress(double(done) / tile_count);
-        }
-    };
-    // An explicit thread count may exceed the cores: the global control lets oneTBB start that
-    // many workers (the arena alone would be capped at the core count, with a warning).
-    std::optional<tbb::global_control> parallelism;
-    if (settings.threads > 0) {
-        parallelism.emplace(tbb::global_control::max_allowed_parallelism, settings.threads);
-    }
-    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    arena.execute(
-        [&] { tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), render_tiles); });
+    for_each_pixel(settings, tallies, [&](int x, int y, QueryScratch& scratch, RayTally& tally) {
+        render_pixel(frame, x, y, result.image.at(x, y), scratch, tally);
+    });
 
     const auto pixels = static_cast<std::uint64_t>(result.image.pixel_count());
     const auto samples = static_cast<std::uint64_t>(settings.samples_per_pixel);
@@ -352,6 +389,11 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
         result.stats.centre_ray_work.nodes_visited += tally.centre_ray_work.nodes_visited;
         result.stats.centre_ray_work.primitives_tested += tally.centre_ray_work.primitives_tested;
         result.stats.centre_ray_work.boxes_tested += tally.centre_ray_work.boxes_tested;
+        result.stats.centre_ray_cost += tally.centre_ray_cost;
+        for (const auto& [kind, count] : tally.hits_by_leaf_kind)
+            result.stats.hits_by_leaf_kind[std::string(kind)] += count;
+        for (const auto& [kind, count] : tally.solves_by_kind)
+            result.stats.solves_by_kind[std::string(kind)] += count;
         for (std::size_t i = 0; i < tally.hits_per_object.size(); ++i) {
             result.stats.hits_per_object[i] += tally.hits_per_object[i];
         }
@@ -359,6 +401,36 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
+}
+
+CostLayer render_cost(const Scene& scene, const RenderSettings& settings) {
+    validate(settings);
+    require(scene.is_committed(), "render_cost", "scene", "committed", "not committed");
+    scene.camera().validate();
+    const Frame frame{scene, settings,
+                      CameraFilm(scene.camera(), double(settings.width) / settings.height),
+                      StrataGrid{}};
+    CostLayer layer;
+    layer.width = settings.width;
+    layer.height = settings.height;
+    const std::size_t pixels = std::size_t(settings.width) * std::size_t(settings.height);
+    for (std::vector<float>* channel :
+         {&layer.nodes, &layer.primitives, &layer.solves, &layer.total}) {
+        channel->assign(pixels, 0.0f);
+    }
+    struct NoWorker {};
+    tbb::enumerable_thread_specific<NoWorker> workers;
+    for_each_pixel(settings, workers, [&](int x, int y, QueryScratch& scratch, NoWorker&) {
+        TraversalCounters counters;
+        QueryCost cost;
+        trace_centre_ray(frame, x, y, scratch, counters, cost);
+        const std::size_t i = std::size_t(y) * std::size_t(settings.width) + std::size_t(x);
+        layer.nodes[i] = static_cast<float>(cost.nodes);
+        layer.primitives[i] = static_cast<float>(cost.primitives);
+        layer.solves[i] = static_cast<float>(cost.solves);
+        layer.total[i] = static_cast<float>(cost.total());
+    });
+    return layer;
 }
 
 }  // namespace csgrt

@@ -198,7 +198,8 @@ TEST_F(CommandLine, StatsPrintsATableOfRaysHitsWorkAndTimes) {
     ASSERT_EQ(result.status, 0) << result.err;
     for (const char* fragment :
          {"Rays", "camera", "shadow", "% blocked", "Camera-ray hits", "Top-level structure (brute)",
-          "primitives tested", "Time", "load scene", "commit", "render", "write files"}) {
+          "primitives tested", "Every level", "box tests", "primitive tests", "root solves", "Time",
+          "load scene", "commit", "render", "write files"}) {
         EXPECT_NE(result.out.find(fragment), std::string::npos) << fragment << ": " << result.out;
     }
     // 200 camera rays at 1 spp, their count printed in the table as in the summary line.
@@ -212,6 +213,29 @@ TEST_F(CommandLine, StatsPrintsATableOfRaysHitsWorkAndTimes) {
               0);
     EXPECT_TRUE(read_exr(output_).metadata.include_timing);
     EXPECT_EQ(read_exr(output_).metadata.objects.size(), 3u);
+}
+
+TEST_F(CommandLine, CostAllWritesALayerPerStructureAndTheirContactSheet) {
+    const ProgramRun result = run({"render", scene_, "-o", output_, "--width", "12", "--height",
+                                   "8", "--cost-all", "--stats"});
+    ASSERT_EQ(result.status, 0) << result.err;
+    EXPECT_EQ(names_in(directory_), (std::vector<std::string>{"out.cost-all.png", "out.cost.png",
+                                                              "out.exr", "out.png", "scene.json"}));
+    EXPECT_NE(result.out.find("out.cost-all.png"), std::string::npos) << result.out;
+    const ExrFile file = read_exr(output_);
+    std::vector<std::string> structures;
+    for (const CostLayer& layer : file.cost_layers) {
+        structures.push_back(layer.structure);
+        EXPECT_EQ(layer.total.size(), 96u);
+        EXPECT_NE(result.out.find("  " + layer.structure + " "), std::string::npos)
+            << layer.structure << " in the statistics:\n"
+            << result.out;
+    }
+    std::vector<std::string> expected(accelerator_names().begin(), accelerator_names().end());
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(structures, expected);  // the file lists channels alphabetically
+    EXPECT_NE(result.out.find("Every structure at every level"), std::string::npos);
+    EXPECT_NE(result.out.find("cost of every structure"), std::string::npos);
 }
 
 TEST_F(CommandLine, EveryDocumentedStructureRendersTheSameImage) {
@@ -279,15 +303,15 @@ TEST_F(CommandLine, AnUnwritableOutputFolderIsRefusedBeforeRendering) {
 }
 
 TEST_F(CommandLine, AnImageLargerThanMemoryIsRefusedWithTheEstimate) {
-    // 640 x 480 pixels of 40 bytes (every channel) plus 16 for writing: 17,203,200 bytes,
-    // 17 MiB rounded up, against a 1 MiB budget.
+    // 640 x 480 pixels of 52 bytes (every channel) plus 16 for writing: 20,889,600 bytes,
+    // 20 MiB rounded up, against a 1 MiB budget.
     const char* argv[] = {"csgrt", "render", scene_.c_str(), "-o", output_.c_str()};
     std::ostringstream out, err;
     CommandLineStreams streams{out, err};
     streams.memory_bytes = 1u << 20;
     EXPECT_EQ(run_csgrt(5, argv, streams), 2);  // a usage error: the size asked for
     EXPECT_NE(
-        err.str().find("a 640x480 image needs about 17 MiB, more than the 1 MiB of memory free"),
+        err.str().find("a 640x480 image needs about 20 MiB, more than the 1 MiB of memory free"),
         std::string::npos)
         << err.str();
     expect_no_output();

@@ -163,8 +163,9 @@ TEST(Compositor, OpenImageIoListsTheChannelsWithTheirTypes) {
     const std::string info = run(iinfo.string() + " -v -a " + (directory / "out.exr").string());
     for (const char* expected :
          {"2 subimages",
-          "channel list: R (half), G (half), B (half), A (half), Z (float), cost (float), "
-          "N.X (float), N.Y (float), N.Z (float)",
+          "channel list: R (half), G (half), B (half), A (half), Z (float), N.X (float), "
+          "N.Y (float), N.Z (float), cost.nodes (float), cost.primitives (float), "
+          "cost.solves (float), cost.total (float)",
           "1 channel, uint openexr", "channel list: id", "name: \"rgba\"", "name: \"id\"",
           "cameraPosition: 0.5, 2.5, 6", "scene: \"spheres.json\""}) {
         EXPECT_NE(info.find(expected), std::string::npos) << expected << " in:\n" << info;
@@ -194,19 +195,22 @@ TEST(Compositor, OpenImageIoReadsEveryPixelAsWritten) {
             const std::vector<std::string>& id = subimages[1].at({x, y});
             ASSERT_EQ(id.size(), 2u);
             EXPECT_EQ(std::stoull(id[0]), pixel.object_id) << x << ", " << y;
-            // R G B A Z cost N.X N.Y N.Z, printed with 9 decimals: the half colour and the
-            // float channels agree to the last printed digit (5e-10 absolute).
+            // R G B A Z N.X N.Y N.Z and the cost layer, printed with 9 decimals: the half
+            // colour and the float channels agree to the last printed digit (5e-10 absolute).
             const std::vector<std::string>& values = subimages[0].at({x, y});
-            ASSERT_EQ(values.size(), 9u);
-            const std::array<float, 9> expected = {float(half(pixel.red)),
-                                                   float(half(pixel.green)),
-                                                   float(half(pixel.blue)),
-                                                   float(half(pixel.alpha)),
-                                                   pixel.depth,
-                                                   pixel.cost,
-                                                   pixel.normal_x,
-                                                   pixel.normal_y,
-                                                   pixel.normal_z};
+            ASSERT_EQ(values.size(), 12u);
+            const std::array<float, 12> expected = {float(half(pixel.red)),
+                                                    float(half(pixel.green)),
+                                                    float(half(pixel.blue)),
+                                                    float(half(pixel.alpha)),
+                                                    pixel.depth,
+                                                    pixel.normal_x,
+                                                    pixel.normal_y,
+                                                    pixel.normal_z,
+                                                    pixel.cost_nodes,
+                                                    pixel.cost_primitives,
+                                                    pixel.cost_solves,
+                                                    pixel.cost};
             for (std::size_t c = 0; c < expected.size(); ++c) {
                 if (std::isinf(expected[c])) {
                     EXPECT_EQ(values[c], "inf") << x << ", " << y << " channel " << c;
@@ -249,6 +253,7 @@ TEST(Compositor, AnOpenImageIoCopyReadsBackTheSamePixels) {
         ASSERT_EQ(b.depth, a.depth) << i;
         ASSERT_EQ(b.normal_y, a.normal_y) << i;
         ASSERT_EQ(b.cost, a.cost) << i;
+        ASSERT_EQ(b.cost_solves, a.cost_solves) << i;
         ASSERT_EQ(b.object_id, a.object_id) << i;  // exact, 2^24 + 1 included
     }
     EXPECT_EQ(copy.metadata.camera.position, Point3(0.5, 2.5, 6.0));

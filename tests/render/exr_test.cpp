@@ -9,6 +9,7 @@
 #include <OpenEXR/ImfInputPart.h>
 #include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
@@ -65,7 +66,10 @@ Image sample_image() {
             pixel.normal_y = float(n.y());
             pixel.normal_z = float(n.z());
             pixel.object_id = 1000000u * x + 7u * y;  // beyond float's exact integers
-            pixel.cost = float(17 * x + y);
+            pixel.cost_nodes = float(3 * x);
+            pixel.cost_primitives = float(y + 1);
+            pixel.cost_solves = float(x * y);
+            pixel.cost = pixel.cost_nodes + pixel.cost_primitives + pixel.cost_solves;
         }
     }
     return image;
@@ -100,9 +104,18 @@ TEST(WriteExr, WritesTheDocumentedChannelsAndAttributes) {
     const Imf::Header& header = file.header();
     const Imf::ChannelList& channels = header.channels();
     const std::vector<std::pair<std::string, Imf::PixelType>> expected = {
-        {"A", Imf::HALF},    {"B", Imf::HALF},    {"G", Imf::HALF},
-        {"N.X", Imf::FLOAT}, {"N.Y", Imf::FLOAT}, {"N.Z", Imf::FLOAT},
-        {"R", Imf::HALF},    {"Z", Imf::FLOAT},   {"cost", Imf::FLOAT}};
+        {"A", Imf::HALF},
+        {"B", Imf::HALF},
+        {"G", Imf::HALF},
+        {"N.X", Imf::FLOAT},
+        {"N.Y", Imf::FLOAT},
+        {"N.Z", Imf::FLOAT},
+        {"R", Imf::HALF},
+        {"Z", Imf::FLOAT},
+        {"cost.nodes", Imf::FLOAT},
+        {"cost.primitives", Imf::FLOAT},
+        {"cost.solves", Imf::FLOAT},
+        {"cost.total", Imf::FLOAT}};
     std::vector<std::pair<std::string, Imf::PixelType>> found;
     for (auto it = channels.begin(); it != channels.end(); ++it) {
         found.emplace_back(it.name(), it.channel().type);
@@ -133,15 +146,18 @@ TEST(WriteExr, WritesTheDocumentedChannelsAndAttributes) {
     EXPECT_LT((right - Imath::V3f(1, 0, 0)).length(), 1e-6f);
 
     // Pixels: colour rounded to half, everything else exact.
-    std::vector<float> red(15), depth(15), cost(15);
+    std::vector<float> red(15), depth(15), cost(15), solves(15);
     std::vector<std::uint32_t> id(15);
     Imf::FrameBuffer frame_buffer;
     frame_buffer.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(red.data()),
                                         sizeof(float), 5 * sizeof(float)));
     frame_buffer.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(depth.data()),
                                         sizeof(float), 5 * sizeof(float)));
-    frame_buffer.insert("cost", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(cost.data()),
-                                           sizeof(float), 5 * sizeof(float)));
+    frame_buffer.insert("cost.total", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(cost.data()),
+                                                 sizeof(float), 5 * sizeof(float)));
+    frame_buffer.insert(
+        "cost.solves", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(solves.data()), sizeof(float),
+                                  5 * sizeof(float)));
     file.setFrameBuffer(frame_buffer);
     file.readPixels(0, 2);
     Imf::MultiPartInputFile parts((directory / "out.exr").c_str());
@@ -167,6 +183,7 @@ TEST(WriteExr, WritesTheDocumentedChannelsAndAttributes) {
             EXPECT_EQ(red[i], float(half(pixel.red)));
             EXPECT_EQ(depth[i], pixel.depth);
             EXPECT_EQ(cost[i], pixel.cost);
+            EXPECT_EQ(solves[i], pixel.cost_solves);
             EXPECT_EQ(id[i], pixel.object_id);
         }
     }
@@ -196,6 +213,9 @@ TEST(ReadExr, RoundTripsPixelsAndMetadata) {
         EXPECT_EQ(b.normal_z, a.normal_z);
         EXPECT_EQ(b.object_id, a.object_id);
         EXPECT_EQ(b.cost, a.cost);
+        EXPECT_EQ(b.cost_nodes, a.cost_nodes);
+        EXPECT_EQ(b.cost_primitives, a.cost_primitives);
+        EXPECT_EQ(b.cost_solves, a.cost_solves);
     }
     EXPECT_EQ(file.metadata.camera.projection, Camera::Projection::Orthographic);
     EXPECT_EQ(file.metadata.camera.orthographic_height, 3.5);
@@ -203,6 +223,28 @@ TEST(ReadExr, RoundTripsPixelsAndMetadata) {
     EXPECT_EQ(file.metadata.camera.look_at, Point3(1, 2, 0));
     EXPECT_EQ(file.metadata.accelerator, "brute");
     EXPECT_EQ(file.metadata.samples_per_pixel, 16);
+}
+
+TEST(ReadExr, ReadsTheOneCostChannelOfEarlierFilesAsTheTotal) {
+    // Files before the cost layer had one channel "cost" (the top-level structure's count).
+    const auto directory = fresh_directory("exr_legacy_cost");
+    const std::filesystem::path path = directory / "old.exr";
+    std::vector<float> cost = {1.0f, 2.0f, 40.0f, 7.0f};
+    {
+        Imf::Header header(2, 2);
+        header.channels().insert("cost", Imf::Channel(Imf::FLOAT));
+        Imf::OutputFile file(path.c_str(), header);
+        Imf::FrameBuffer frame_buffer;
+        frame_buffer.insert("cost", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(cost.data()),
+                                               sizeof(float), 2 * sizeof(float)));
+        file.setFrameBuffer(frame_buffer);
+        file.writePixels(2);
+    }
+    const Image image = read_exr(path).image;
+    for (std::size_t i = 0; i < cost.size(); ++i) {
+        EXPECT_EQ(image.pixels()[i].cost, cost[i]);
+        EXPECT_EQ(image.pixels()[i].cost_nodes, 0.0f);  // not in the file: the default
+    }
 }
 
 TEST(WriteExr, TheIdManifestNamesEveryObject) {

@@ -128,6 +128,37 @@ TEST_P(Golden, MatchesTheStoredImage) {
         << golden.name << ": " << outliers << " pixels outside the tolerance";
 }
 
+TEST(Showcase, EveryObjectIsInFrameAndNoneIsCutByTheEdge) {
+    // The shipped showcase (docs/rendering.md, README): every bounded object shows, and none
+    // reaches a border pixel, where the frame would cut it. Ids of the centre rays, 160 x 120
+    // (the docs' aspect ratio): a pixel is 1/120 of the 38-degree field, finer than any gap.
+    Scene scene = load_scene(kScenes / "showcase.json");
+    scene.commit();
+    RenderSettings settings;
+    settings.width = 160;
+    settings.height = 120;
+    settings.max_depth = 0;
+    const Image image = render(scene, settings).image;
+    std::vector<bool> seen(scene.objects().size(), false);
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < image.width(); ++x) {
+            const std::uint32_t id = image.at(x, y).object_id;
+            if (id == kNoIndex) continue;
+            seen[id] = true;
+            const bool border =
+                x == 0 || y == 0 || x == image.width() - 1 || y == image.height() - 1;
+            if (border && scene.objects()[id].shape->bounds().is_finite()) {
+                ADD_FAILURE() << "object " << id << " (" << scene.objects()[id].name
+                              << ") touches the edge at " << x << ", " << y;
+            }
+        }
+    }
+    for (std::size_t id = 0; id < seen.size(); ++id) {
+        EXPECT_TRUE(seen[id]) << "object " << id << " (" << scene.objects()[id].name
+                              << ") is not in frame";
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Canonical, Golden, ::testing::ValuesIn(golden_cases()),
                          [](const auto& info) { return info.param.name; });
 

@@ -188,6 +188,70 @@ TEST(WriteCostPng, DrawsALabelledScaleBelowTheImage) {
     EXPECT_EQ(cost_label(2.5e6), "2.5M");
 }
 
+TEST(WriteCostSheetPng, PutsEveryLayerOnOneScaleUnderItsLabel) {
+    const auto directory = fresh_directory("png_cost_sheet");
+    // Three 40 x 3 layers whose costs differ by a factor: on one logarithmic scale the first
+    // layer's largest cost (10) is log(11) / log(41) of the way up the bar whose end is the
+    // third's (40).
+    std::vector<CostLayer> layers;
+    for (const char* name : {"brute", "grid", "bvh"}) {
+        CostLayer layer;
+        layer.structure = name;
+        layer.build_milliseconds = 1.5;
+        layer.width = 40;
+        layer.height = 3;
+        layer.total.assign(120, 0.0f);
+        layers.push_back(layer);
+    }
+    layers[0].total[0] = 10.0f;
+    layers[1].total[41] = 20.0f;   // (1, 1)
+    layers[2].total[119] = 40.0f;  // (39, 2)
+    write_cost_sheet_png(directory / "sheet.png", layers);
+    const Rgb8 png = read_png(directory / "sheet.png");
+    const CostSheetLayout layout = cost_sheet_layout(3, 40, 3);
+    // Two columns (2^2 >= 3), two rows; the width holds two tiles and the gap between them.
+    EXPECT_EQ(layout.columns, 2);
+    EXPECT_EQ(layout.rows, 2);
+    EXPECT_EQ(layout.width, 80 + layout.gap);
+    ASSERT_EQ(png.width, layout.width);
+    ASSERT_EQ(png.height, layout.scale_top + cost_scale_height(layout.width));
+    auto code = [](double t) {
+        const Vector3 c = viridis(t);
+        return std::array<int, 3>{int(std::lround(c.x() * 255)), int(std::lround(c.y() * 255)),
+                                  int(std::lround(c.z() * 255))};
+    };
+    auto tile_pixel = [&](int tile, int x, int y) {
+        const int left = tile % layout.columns * (40 + layout.gap);
+        const int top = tile / layout.columns * (layout.label_height + 3) + layout.label_height;
+        return png.at(left + x, top + y);
+    };
+    EXPECT_EQ(tile_pixel(0, 0, 0), code(std::log(11.0) / std::log(41.0)));
+    EXPECT_EQ(tile_pixel(0, 1, 0), code(0.0));
+    EXPECT_EQ(tile_pixel(1, 1, 1), code(std::log(21.0) / std::log(41.0)));
+    EXPECT_EQ(tile_pixel(2, 39, 2), code(1.0));
+    // Each label strip has text in the light colour.
+    for (int tile = 0; tile < 3; ++tile) {
+        const int left = tile % layout.columns * (40 + layout.gap);
+        const int top = tile / layout.columns * (layout.label_height + 3);
+        int lit = 0;
+        for (int y = top; y < top + layout.label_height; ++y) {
+            for (int x = left; x < left + 40; ++x) {
+                lit += png.at(x, y) == std::array<int, 3>{235, 235, 235};
+            }
+        }
+        EXPECT_GT(lit, 10) << tile;
+    }
+    // The scale's bar ends at the largest cost of all layers: viridis(1) at its right end.
+    EXPECT_EQ(png.at(layout.width - 4, layout.scale_top + 8), code(1.0));
+
+    EXPECT_EQ(cost_fraction(0.0, 0.0, true), 0.0);
+    EXPECT_EQ(cost_fraction(40.0, 40.0, true), 1.0);
+    EXPECT_EQ(cost_fraction(10.0, 40.0, false), 0.25);
+    EXPECT_THROW(write_cost_sheet_png(directory / "none.png", {}), std::runtime_error);
+    layers[1].height = 4;
+    EXPECT_THROW(write_cost_sheet_png(directory / "mixed.png", layers), std::runtime_error);
+}
+
 TEST(WriteColourPng, ReportsAnUnwritablePath) {
     const auto directory = fresh_directory("png_bad");
     EXPECT_THROW(write_colour_png(directory / "missing" / "c.png", Image(1, 1)),

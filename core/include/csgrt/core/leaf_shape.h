@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "csgrt/core/query_cost.h"
 #include "csgrt/core/shape.h"
 
 namespace csgrt {
@@ -38,7 +39,9 @@ public:
 };
 
 template <class Derived>
-bool LeafShape<Derived>::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch&) const {
+bool LeafShape<Derived>::nearest_hit(const Ray& ray, HitRecord& record,
+                                     QueryScratch& scratch) const {
+    count_solve(scratch, *this);
     const std::optional<Crossing> crossing = static_cast<const Derived&>(*this).crossing(ray);
     if (!crossing) return false;
     record = HitRecord{.t = crossing->t,
@@ -50,7 +53,8 @@ bool LeafShape<Derived>::nearest_hit(const Ray& ray, HitRecord& record, QueryScr
 }
 
 template <class Derived>
-bool LeafShape<Derived>::any_hit(const Ray& ray, QueryScratch&) const {
+bool LeafShape<Derived>::any_hit(const Ray& ray, QueryScratch& scratch) const {
+    count_solve(scratch, *this);
     return static_cast<const Derived&>(*this).crossing(ray).has_value();
 }
 

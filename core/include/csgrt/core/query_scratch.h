@@ -10,6 +10,7 @@
 namespace csgrt {
 
 class Instance;
+struct QueryCost;
 
 /// Working memory for one query at a time, owned by the caller (one per thread) and reused
 /// from ray to ray, so that once its buffers have grown no query allocates. It holds the
@@ -42,6 +43,11 @@ public:
     std::vector<HitRecord>& borrow_hits() { return borrow(hit_pool_, hits_in_use_); }
     void return_hits() { --hits_in_use_; }
 
+    /// Where queries made with this scratch add their work (core/query_cost.h: CostScope sets
+    /// it), or null when nothing is counted.
+    QueryCost* cost() const { return cost_; }
+    void set_cost(QueryCost* cost) { cost_ = cost; }
+
 private:
     template <class List>
     static List& borrow(std::vector<std::unique_ptr<List>>& pool, std::size_t& in_use) {
@@ -57,6 +63,7 @@ private:
     std::vector<std::unique_ptr<std::vector<HitRecord>>> hit_pool_;
     std::size_t spans_in_use_ = 0;
     std::size_t hits_in_use_ = 0;
+    QueryCost* cost_ = nullptr;
 };
 
 /// Borrows a span list from `scratch` for the enclosing scope.

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -44,18 +45,25 @@ struct ExrMetadata {
 std::vector<ExrObject> exr_objects(const Scene& scene);
 
 /// A csgrt EXR has two parts (OpenEXR 2 multi-part; docs/rendering.md):
-/// - "rgba": R, G, B, A as half (linear, premultiplied); Z, N.X, N.Y, N.Z and cost as float;
+/// - "rgba": R, G, B, A as half (linear, premultiplied); Z, N.X, N.Y, N.Z and the cost layer
+///   (cost.nodes, cost.primitives, cost.solves, cost.total) as float;
 /// - "id": id as uint (kNoIndex = 4294967295 for background), with the idManifest.
 /// ZIP compressed, no timestamps. Readers that know one part only (Imf::InputFile) see "rgba".
+/// Each of `cost_layers` (csgrt render --cost-all) adds the float channels
+/// cost.<structure>.nodes, .primitives, .solves and .total to "rgba", and the header attribute
+/// cost.<structure>.buildMilliseconds (a timing: such files differ from run to run).
 /// Written to a temporary file in the same directory and renamed over `path`, so `path` is
 /// either the old file or the complete new one. Throws std::runtime_error naming the path when
 /// it cannot be written.
-void write_exr(const std::filesystem::path& path, const Image& image, const ExrMetadata& metadata);
+void write_exr(const std::filesystem::path& path, const Image& image, const ExrMetadata& metadata,
+               std::span<const CostLayer> cost_layers = {});
 
 /// An EXR read back: the pixels (colour as stored, i.e. rounded to half) and the metadata.
 struct ExrFile {
     Image image;
     ExrMetadata metadata;
+    /// The --cost-all layers, in the file's (alphabetical) order.
+    std::vector<CostLayer> cost_layers;
 };
 
 /// Reads an EXR written by `write_exr` (or by earlier csgrt versions, all channels in one
@@ -67,13 +75,21 @@ ExrFile read_exr(const std::filesystem::path& path);
 /// (write_colour_png with `tone_mapping`) and the cost channel as `stem.cost.png`
 /// (write_cost_png, with its scale). All three are written to temporary files first and
 /// renamed only when all three are complete; on an error none of them is left half-written and
-/// the temporaries are removed.
+/// the temporaries are removed. With `cost_layers`, the EXR holds them too and a fourth file,
+/// `stem.cost-all.png`, shows them side by side on one scale (write_cost_sheet_png).
 void write_render_files(const std::filesystem::path& exr_path, const Image& image,
-                        const ExrMetadata& metadata, const ToneMapping& tone_mapping = {});
+                        const ExrMetadata& metadata, const ToneMapping& tone_mapping = {},
+                        std::span<const CostLayer> cost_layers = {});
 
 /// The preview paths `write_render_files` uses for `exr_path` (out.exr -> out.png,
 /// out.cost.png).
 std::filesystem::path colour_preview_path(const std::filesystem::path& exr_path);
 std::filesystem::path cost_preview_path(const std::filesystem::path& exr_path);
+/// out.exr -> out.cost-all.png, the --cost-all contact sheet.
+std::filesystem::path cost_sheet_path(const std::filesystem::path& exr_path);
+/// Every file write_render_files writes for `exr_path`: the EXR, the two previews and, when
+/// asked, the contact sheet.
+std::vector<std::filesystem::path> render_file_paths(const std::filesystem::path& exr_path,
+                                                     bool with_cost_sheet);
 
 }  // namespace csgrt

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "csgrt/core/math.h"
@@ -15,7 +16,7 @@ namespace csgrt {
 /// the distance from the camera origin; +inf where nothing is hit), normal is the world-space
 /// shading normal of the surface as the surface defines it (outward for solids, not turned
 /// toward the camera; zero for background), object_id the scene object (kNoIndex for
-/// background) and cost the work the scene's top-level structure did for that ray.
+/// background) and the cost channels the work that ray caused at every level of the scene.
 struct Pixel {
     float red = 0.0f;
     float green = 0.0f;
@@ -26,8 +27,13 @@ struct Pixel {
     float normal_y = 0.0f;
     float normal_z = 0.0f;
     std::uint32_t object_id = kNoIndex;
-    /// Nodes or cells visited plus primitives tested (exact as float up to 2^24).
+    /// The centre ray's work at every level (core/query_cost.h): box tests (structure nodes
+    /// or cells visited, CSG and compound bounding boxes), primitive tests, leaf root solves,
+    /// and `cost` their sum. Counts, exact as float up to 2^24.
     float cost = 0.0f;
+    float cost_nodes = 0.0f;
+    float cost_primitives = 0.0f;
+    float cost_solves = 0.0f;
 };
 
 /// A rendered image: width x height pixels, row-major from the top-left corner.
@@ -55,6 +61,24 @@ private:
     int width_ = 0;
     int height_ = 0;
     std::vector<Pixel> pixels_;
+};
+
+/// The cost channels of one render of a scene whose every structure is one kind
+/// (`csgrt render --cost-all`, docs/rendering.md): per pixel, row-major from the top-left
+/// corner, the centre ray's box tests, primitive tests, root solves and their total, as in
+/// Pixel.
+struct CostLayer {
+    /// The factory name of the structure every level of the scene was built with.
+    std::string structure;
+    /// The build times of every structure in that scene (the top level's, each compound's and
+    /// each mesh's), summed.
+    double build_milliseconds = 0.0;
+    int width = 0;
+    int height = 0;
+    std::vector<float> nodes;
+    std::vector<float> primitives;
+    std::vector<float> solves;
+    std::vector<float> total;
 };
 
 }  // namespace csgrt

@@ -2,9 +2,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
+#include "csgrt/core/query_cost.h"
 
 #include "csgrt/render/image.h"
 
@@ -59,9 +62,16 @@ struct RenderStats {
     std::uint64_t primary_hits = 0;
     /// Camera-ray hits per top-level object, indexed by object id.
     std::vector<std::uint64_t> hits_per_object;
-    /// The top-level structure's work for the centre rays, summed over the image (the cost
-    /// channel's total): nodes or cells visited, primitives tested, boxes tested.
+    /// The top-level structure's work for the centre rays, summed over the image: nodes or
+    /// cells visited, primitives tested, boxes tested.
     TraversalCounters centre_ray_work;
+    /// The centre rays' work at every level (structures inside meshes and compounds, CSG
+    /// nodes, leaf solves), summed over the image: the cost channels' sums.
+    QueryCost centre_ray_cost;
+    /// The centre rays' root solves by the leaf's kind() (their sum is centre_ray_cost.solves).
+    std::map<std::string, std::uint64_t> solves_by_kind;
+    /// Camera-ray hits by the kind() of the leaf hit ("mesh" for a mesh's triangles).
+    std::map<std::string, std::uint64_t> hits_by_leaf_kind;
     double seconds = 0.0;
 
     double million_rays_per_second() const {
@@ -85,11 +95,17 @@ struct RenderResult {
 ///   light tested with one hard shadow ray (Scene::occluded) from an offset origin;
 /// - a scene without lights is lit from the eye instead: radiance = albedo |n . v|, and no
 ///   shadow rays are cast;
-/// - the AOVs (depth, normal, object id, cost) from one counted ray through the pixel centre.
+/// - the AOVs (depth, normal, object id, cost) from one ray through the pixel centre, its work
+///   counted at every level of the scene (core/query_cost.h).
 /// Tiles are rendered in parallel with oneTBB; the image is the same for any thread count.
 /// Throws InvalidParameter for an uncommitted scene, an invalid camera, or a width, height or
 /// sample count outside [1, kMaxImageSize] / [1, kMaxSamplesPerPixel].
 RenderResult render(const Scene& scene, const RenderSettings& settings);
+
+/// The cost channels alone (no shading, no other ray): one centre ray per pixel, counted
+/// exactly as `render` counts it, in parallel like `render`. The layer's structure name and
+/// build time are left for the caller. Throws what `render` throws.
+CostLayer render_cost(const Scene& scene, const RenderSettings& settings);
 
 /// Throws InvalidParameter naming the setting unless `settings` is one `render` accepts.
 void validate(const RenderSettings& settings);
