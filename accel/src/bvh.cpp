@@ -664,7 +664,6 @@ struct BvhTraversal {
         }
 #endif
         for (std::uint32_t m = open; m != 0; m &= m - 1) lanes.make_test(std::countr_zero(m));
-        TraversalCounters unused;
 
         PacketEntry stack[(kWidth - 1) * kMaxDepth + 1];
         PacketEntry* top = stack;
