@@ -52,6 +52,7 @@ Boolean::Boolean(BooleanOperation operation, std::shared_ptr<const Shape> first,
     require_solid(second_, what, "second operand");
     first_bounds_ = first_->bounds();
     second_bounds_ = second_->bounds();
+    coincidence_ = span_coincidence_relative(*first_, *second_);
     switch (operation_) {
         case BooleanOperation::Union:
             bounds_ = join(first_bounds_, second_bounds_);
@@ -115,7 +116,7 @@ bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scrat
         first_->find_spans(ray, first_spans.list(), scratch);
         second_->find_spans(ray, second_spans.list(), scratch);
         return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray,
-                                       record);
+                                       record, coincidence_);
     }
     if (operation_ == BooleanOperation::Difference) count_box_tests(scratch, 1);
     if (operation_ == BooleanOperation::Difference &&
@@ -126,8 +127,8 @@ bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scrat
     BorrowedSpans second_spans(scratch);
     if (!operand_spans(ray, inverse_direction, first_spans.list(), second_spans.list(), scratch))
         return false;
-    return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray,
-                                   record);
+    return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray, record,
+                                   coincidence_);
 }
 
 bool Boolean::any_hit(const Ray& ray, QueryScratch& scratch) const {
@@ -153,7 +154,7 @@ bool Boolean::any_hit(const Ray& ray, QueryScratch& scratch) const {
         first_->find_spans(ray, first_spans.list(), scratch);
         second_->find_spans(ray, second_spans.list(), scratch);
         return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray,
-                                       record);
+                                       record, coincidence_);
     }
     if (operation_ == BooleanOperation::Difference) count_box_tests(scratch, 1);
     if (operation_ == BooleanOperation::Difference &&
@@ -164,8 +165,8 @@ bool Boolean::any_hit(const Ray& ray, QueryScratch& scratch) const {
     BorrowedSpans second_spans(scratch);
     if (!operand_spans(ray, inverse_direction, first_spans.list(), second_spans.list(), scratch))
         return false;
-    return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray,
-                                   record);
+    return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray, record,
+                                   coincidence_);
 }
 
 void Boolean::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
@@ -190,7 +191,8 @@ void Boolean::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch)
         BorrowedSpans second_spans(scratch);
         first_->find_spans(ray, first_spans.list(), scratch);
         second_->find_spans(ray, second_spans.list(), scratch);
-        combine_spans(operation_, first_spans.list(), second_spans.list(), ray, spans);
+        combine_spans(operation_, first_spans.list(), second_spans.list(), ray, spans,
+                      coincidence_);
         return;
     }
     if (operation_ == BooleanOperation::Difference) count_box_tests(scratch, 1);
@@ -203,7 +205,7 @@ void Boolean::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch)
     BorrowedSpans second_spans(scratch);
     if (!operand_spans(ray, inverse_direction, first_spans.list(), second_spans.list(), scratch))
         return;
-    combine_spans(operation_, first_spans.list(), second_spans.list(), ray, spans);
+    combine_spans(operation_, first_spans.list(), second_spans.list(), ray, spans, coincidence_);
 }
 
 bool Boolean::contains(const Point3& p) const {

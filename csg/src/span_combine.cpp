@@ -2,6 +2,10 @@
 
 #include <cmath>
 #include <cstddef>
+#include <unordered_set>
+#include <vector>
+
+#include "csgrt/mesh/mesh.h"
 
 namespace csgrt {
 
@@ -13,9 +17,27 @@ double origin_over_direction(const Ray& ray) {
     return ray.origin.cwiseAbs().maxCoeff() / ray.direction.cwiseAbs().maxCoeff();
 }
 
-double coincidence_tolerance(double origin_over_direction, double t) {
+double coincidence_tolerance(double relative, double origin_over_direction, double t) {
     if (!std::isfinite(t)) return 0.0;
-    return kSpanCoincidenceUlps * kUnitRoundoff * (std::abs(t) + origin_over_direction);
+    return relative * (std::abs(t) + origin_over_direction);
+}
+
+/// Whether a float Mesh lies anywhere beneath `root`; each shared shape is visited once, so a
+/// grid of copies of one definition costs one walk of it.
+bool holds_float_mesh(const Shape& root) {
+    std::vector<const Shape*> pending{&root};
+    std::unordered_set<const Shape*> seen;
+    while (!pending.empty()) {
+        const Shape* shape = pending.back();
+        pending.pop_back();
+        if (shape == nullptr || !seen.insert(shape).second) continue;
+        if (const auto* mesh = dynamic_cast<const Mesh*>(shape)) {
+            if (!mesh->double_precision()) return true;
+            continue;
+        }
+        for (const Shape* child : shape->children()) pending.push_back(child);
+    }
+    return false;
 }
 
 /// What one operand does within a group of ends that count as coincident.
@@ -138,7 +160,7 @@ const Span* touching_point(BooleanOperation operation, const OperandStep& first,
 /// (`point`); either may return false to stop.
 template <class Visitor>
 void sweep(BooleanOperation operation, const SpanList& first_spans, const SpanList& second_spans,
-           const Ray& ray, Visitor& visitor) {
+           const Ray& ray, double relative, Visitor& visitor) {
     Cursor first(first_spans);
     Cursor second(second_spans);
     const double scale = origin_over_direction(ray);
@@ -149,7 +171,7 @@ void sweep(BooleanOperation operation, const SpanList& first_spans, const SpanLi
         if (!visitor.group(t)) return;
         // A group is every end within the tolerance of its earliest one; the negated tests
         // step an operand with a NaN end rather than skipping it forever.
-        const double limit = t + coincidence_tolerance(scale, t);
+        const double limit = t + coincidence_tolerance(relative, scale, t);
         const OperandStep a = !(first_t > limit) ? first.advance(limit) : first.stay();
         const OperandStep b = !(second_t > limit) ? second.advance(limit) : second.stay();
         const bool before = classify(operation, a.before, b.before);
@@ -201,21 +223,27 @@ struct FirstBoundary {
 
 }  // namespace
 
-double span_coincidence_tolerance(const Ray& ray, double t) {
-    return coincidence_tolerance(origin_over_direction(ray), t);
+double span_coincidence_tolerance(const Ray& ray, double t, double relative) {
+    return coincidence_tolerance(relative, origin_over_direction(ray), t);
+}
+
+double span_coincidence_relative(const Shape& first, const Shape& second) {
+    return holds_float_mesh(first) || holds_float_mesh(second) ? kFloatSpanCoincidence
+                                                               : kDoubleSpanCoincidence;
 }
 
 void combine_spans(BooleanOperation operation, const SpanList& first, const SpanList& second,
-                   const Ray& ray, SpanList& result) {
+                   const Ray& ray, SpanList& result, double relative) {
     result.clear();
     ListBuilder builder{result};
-    sweep(operation, first, second, ray, builder);
+    sweep(operation, first, second, ray, relative, builder);
 }
 
 bool first_combined_boundary(BooleanOperation operation, const SpanList& first,
-                             const SpanList& second, const Ray& ray, HitRecord& boundary) {
+                             const SpanList& second, const Ray& ray, HitRecord& boundary,
+                             double relative) {
     FirstBoundary finder{ray, boundary};
-    sweep(operation, first, second, ray, finder);
+    sweep(operation, first, second, ray, relative, finder);
     return finder.found;
 }
 

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 #include <limits>
 
@@ -60,6 +61,11 @@ CgalReference& CgalReference::operator=(CgalReference&&) noexcept = default;
 
 std::size_t CgalReference::size() const {
     return corners_.size();
+}
+
+double CgalReference::distance(const Point3& point) const {
+    if (corners_.empty()) return kInfinity;
+    return std::sqrt(CGAL::to_double(tree_->tree.squared_distance(to_cgal(point))));
 }
 
 namespace {

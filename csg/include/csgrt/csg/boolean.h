@@ -61,6 +61,9 @@ private:
     Aabb first_bounds_;
     Aabb second_bounds_;
     Aabb bounds_;
+    /// The operands' span coincidence tolerance (span_coincidence_relative): float-sized when
+    /// either holds a float mesh.
+    double coincidence_ = kDoubleSpanCoincidence;
 };
 
 /// The union of one or more solids as a balanced tree of binary nodes (depth log2 n, which

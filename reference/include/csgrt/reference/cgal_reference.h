@@ -46,6 +46,10 @@ public:
     /// benchmark. Not exact: it orders hits by inexactly constructed points.
     std::optional<std::uint32_t> first_intersected_primitive(const Ray& ray) const;
 
+    /// The distance from `point` to the nearest triangle (CGAL's AABB tree distance query,
+    /// computed in double: for telling whether a point lies on the surface within a tolerance).
+    double distance(const Point3& point) const;
+
     std::size_t size() const;
     /// Parameter t of the ray's line at the plane of triangle `primitive`, in long double.
     long double plane_t(const Ray& ray, std::uint32_t primitive) const;
