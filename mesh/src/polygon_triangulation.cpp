@@ -10,44 +10,32 @@ namespace csgrt::detail {
 
 namespace {
 
-/// Ear clipping over a doubly linked ring of a polygon's corners, with the ear test limited to
-/// the corners near the ear by a z-order (Morton) index, after Mapbox's earcut (Agafonkin,
-/// https://github.com/mapbox/earcut, 2016; Eberly, "Triangulation by Ear Clipping", 2002 for
-/// the method). A corner that blocks an ear must be reflex and inside it; a corner at the same
-/// place as the ear's first corner does not block it, so a keyhole polygon (the outer loop, a
-/// bridge, the hole and the bridge back, with the bridge's corners repeated) is clipped around
-/// its hole. The corners looked at per ear are those whose Morton codes lie within the ear's
-/// box, so polygons of 10^5 corners take milliseconds instead of the minutes of the quadratic
-/// scan. Points are 2D, counter-clockwise.
+/// Ear clipping over a doubly linked ring of a polygon's corners (Eberly, "Triangulation by
+/// Ear Clipping", 2002; the ring filtering and local cures follow Mapbox's earcut, Agafonkin,
+/// https://github.com/mapbox/earcut, 2016). A corner that blocks an ear must be reflex or
+/// collinear and lie in it; a corner at the same place as the ear's first corner does not block
+/// it, so a keyhole polygon (the outer loop, a bridge, the hole and the bridge back, with the
+/// bridge's corners repeated) is clipped around its hole. Points are 2D, counter-clockwise.
+///
+/// The corners still in the ring are found by a static kd-tree (built once, O(n log n)) whose
+/// nodes count the corners left under them: an ear test descends only into nodes that hold
+/// corners and whose box is not wholly outside the ear, so a long thin ear (a fan across a
+/// comb's base or along a side of collinear corners, the ears such polygons force) visits the
+/// few cells along its edges instead of every corner in its bounding box, which earcut's
+/// z-order scan visited. With the walk resuming at the corner before each ear (below), such
+/// polygons of 10^5 corners take milliseconds; they took 17 s (docs/accuracy.md).
 class EarClipper {
 public:
     EarClipper(const std::vector<Eigen::Vector2d>& points,
                std::vector<std::array<std::uint32_t, 3>>& out)
         : points_(points), out_(out), nodes_(points.size()) {
         const std::size_t n = points.size();
-        Eigen::Vector2d lower = points[0], upper = points[0];
-        for (const Eigen::Vector2d& p : points) {
-            lower = lower.cwiseMin(p);
-            upper = upper.cwiseMax(p);
-        }
-        lower_ = lower;
-        const double size = (upper - lower).maxCoeff();
-        inverse_size_ = size > 0.0 && std::isfinite(size) ? 32767.0 / size : 0.0;
         for (std::size_t i = 0; i < n; ++i) {
             Node& node = nodes_[i];
             node.prev = static_cast<int>((i + n - 1) % n);
             node.next = static_cast<int>((i + 1) % n);
-            node.z = morton(points[i]);
         }
-        // The z-order list: every corner sorted by Morton code.
-        std::vector<int> order(n);
-        for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<int>(i);
-        std::sort(order.begin(), order.end(),
-                  [&](int a, int b) { return nodes_[a].z < nodes_[b].z; });
-        for (std::size_t k = 0; k < n; ++k) {
-            nodes_[order[k]].prev_z = k > 0 ? order[k - 1] : -1;
-            nodes_[order[k]].next_z = k + 1 < n ? order[k + 1] : -1;
-        }
+        build_tree();
     }
 
     /// Clips the ring; returns the corners left when no ear and no local fix remains (empty
@@ -62,7 +50,11 @@ public:
             if (is_ear(ear)) {
                 emit(prev, ear, next);
                 remove(ear);
-                ear = nodes_[next].next;
+                // The corner before the ear has a new neighbour, so it may have become an ear:
+                // look there first. Earcut moves on past the next corner, which leaves such
+                // corners for the next round; on a side of collinear corners (no ear but at
+                // the ends) every round then walked the whole ring for one ear.
+                ear = prev;
                 stop = ear;
                 continue;
             }
@@ -91,28 +83,69 @@ public:
 
 private:
     struct Node {
-        int prev = -1, next = -1, prev_z = -1, next_z = -1;
-        std::uint32_t z = 0;
+        int prev = -1, next = -1;
     };
+
+    /// A kd-tree node over order_[begin, end): the box of its corners and how many of them are
+    /// still in the ring. Children of node k are 2k + 1 and 2k + 2, splitting at the middle.
+    struct Cell {
+        Eigen::Vector2d lower, upper;
+        std::uint32_t begin = 0, end = 0;
+        std::uint32_t left = 0;
+    };
+    static constexpr std::size_t kLeafSize = 8;
 
     /// Twice the signed area of (a, b, c): positive when counter-clockwise.
     double cross(int a, int b, int c) const {
         const Eigen::Vector2d &pa = points_[a], &pb = points_[b], &pc = points_[c];
         return (pb.x() - pa.x()) * (pc.y() - pa.y()) - (pb.y() - pa.y()) * (pc.x() - pa.x());
     }
+    static double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                        const Eigen::Vector2d& c) {
+        return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+    }
     bool same_place(int a, int b) const { return points_[a] == points_[b]; }
 
-    std::uint32_t morton(const Eigen::Vector2d& p) const {
-        auto spread = [](std::uint32_t v) {
-            v = (v | (v << 8)) & 0x00FF00FFu;
-            v = (v | (v << 4)) & 0x0F0F0F0Fu;
-            v = (v | (v << 2)) & 0x33333333u;
-            v = (v | (v << 1)) & 0x55555555u;
-            return v;
+    void build_tree() {
+        const std::size_t n = points_.size();
+        order_.resize(n);
+        for (std::size_t i = 0; i < n; ++i) order_[i] = static_cast<int>(i);
+        std::size_t cells = 1;
+        while (cells * kLeafSize < n) cells *= 2;
+        cells_.resize(2 * cells - 1);
+        leaf_of_.resize(n);
+        // Explicit stack: (cell, begin, end).
+        struct Task {
+            std::size_t cell, begin, end;
         };
-        const auto x = static_cast<std::uint32_t>((p.x() - lower_.x()) * inverse_size_);
-        const auto y = static_cast<std::uint32_t>((p.y() - lower_.y()) * inverse_size_);
-        return spread(x) | (spread(y) << 1);
+        std::vector<Task> tasks{{0, 0, n}};
+        while (!tasks.empty()) {
+            const Task task = tasks.back();
+            tasks.pop_back();
+            Cell& cell = cells_[task.cell];
+            cell.lower = cell.upper = points_[order_[task.begin]];
+            for (std::size_t k = task.begin; k < task.end; ++k) {
+                cell.lower = cell.lower.cwiseMin(points_[order_[k]]);
+                cell.upper = cell.upper.cwiseMax(points_[order_[k]]);
+            }
+            cell.begin = static_cast<std::uint32_t>(task.begin);
+            cell.end = static_cast<std::uint32_t>(task.end);
+            cell.left = cell.end - cell.begin;
+            const std::size_t first_child = 2 * task.cell + 1;
+            if (first_child >= cells_.size() || task.end - task.begin <= 1) {
+                for (std::size_t k = task.begin; k < task.end; ++k) leaf_of_[order_[k]] = task.cell;
+                continue;
+            }
+            // Split the longer side at the median.
+            const int axis = (cell.upper - cell.lower).x() >= (cell.upper - cell.lower).y() ? 0 : 1;
+            const std::size_t middle = task.begin + (task.end - task.begin) / 2;
+            std::nth_element(order_.begin() + static_cast<std::ptrdiff_t>(task.begin),
+                             order_.begin() + static_cast<std::ptrdiff_t>(middle),
+                             order_.begin() + static_cast<std::ptrdiff_t>(task.end),
+                             [&](int a, int b) { return points_[a][axis] < points_[b][axis]; });
+            tasks.push_back({first_child, task.begin, middle});
+            tasks.push_back({first_child + 1, middle, task.end});
+        }
     }
 
     void emit(int a, int b, int c) {
@@ -124,10 +157,12 @@ private:
         Node& node = nodes_[p];
         nodes_[node.next].prev = node.prev;
         nodes_[node.prev].next = node.next;
-        if (node.prev_z >= 0) nodes_[node.prev_z].next_z = node.next_z;
-        if (node.next_z >= 0) nodes_[node.next_z].prev_z = node.prev_z;
+        in_ring_[p] = false;
+        for (std::size_t cell = leaf_of_[p];; cell = (cell - 1) / 2) {
+            --cells_[cell].left;
+            if (cell == 0) break;
+        }
     }
-
     /// Whether corner p, a reflex or collinear corner, lies in the closed ear (a, b, c) and is
     /// not a repetition of a (a keyhole's bridge end).
     bool blocks(int p, int a, int b, int c) const {
@@ -137,24 +172,44 @@ private:
         return cross(nodes_[p].prev, p, nodes_[p].next) <= 0.0;
     }
 
-    bool is_ear(int b) const {
+    /// Whether the box lies wholly on the outer side of the directed edge (from, to) of a
+    /// counter-clockwise triangle: then no point of it is in the triangle.
+    static bool outside(const Cell& cell, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+        for (const Eigen::Vector2d& corner :
+             {cell.lower, cell.upper, Eigen::Vector2d(cell.lower.x(), cell.upper.y()),
+              Eigen::Vector2d(cell.upper.x(), cell.lower.y())}) {
+            if (!(cross(from, to, corner) < 0.0)) return false;
+        }
+        return true;
+    }
+
+    bool is_ear(int b) {
         const int a = nodes_[b].prev, c = nodes_[b].next;
         if (!(cross(a, b, c) > 0.0)) return false;  // reflex or collinear: not an ear
-        const Eigen::Vector2d lower = points_[a].cwiseMin(points_[b]).cwiseMin(points_[c]);
-        const Eigen::Vector2d upper = points_[a].cwiseMax(points_[b]).cwiseMax(points_[c]);
-        const std::uint32_t z_min = morton(lower), z_max = morton(upper);
-        auto in_box = [&](int p) {
-            const Eigen::Vector2d& q = points_[p];
-            return q.x() >= lower.x() && q.x() <= upper.x() && q.y() >= lower.y() &&
-                   q.y() <= upper.y();
-        };
-        // Every corner in the box has a Morton code in [z_min, z_max]: walk both ways from
-        // the ear's own code.
-        for (int p = nodes_[b].prev_z; p >= 0 && nodes_[p].z >= z_min; p = nodes_[p].prev_z) {
-            if (in_box(p) && blocks(p, a, b, c)) return false;
-        }
-        for (int p = nodes_[b].next_z; p >= 0 && nodes_[p].z <= z_max; p = nodes_[p].next_z) {
-            if (in_box(p) && blocks(p, a, b, c)) return false;
+        const Eigen::Vector2d &pa = points_[a], &pb = points_[b], &pc = points_[c];
+        const Eigen::Vector2d lower = pa.cwiseMin(pb).cwiseMin(pc);
+        const Eigen::Vector2d upper = pa.cwiseMax(pb).cwiseMax(pc);
+        // Cells that hold corners of the ring and may meet the closed ear.
+        pending_.assign(1, 0);
+        while (!pending_.empty()) {
+            const std::size_t index = pending_.back();
+            pending_.pop_back();
+            const Cell& cell = cells_[index];
+            if (cell.left == 0 || (cell.lower.array() > upper.array()).any() ||
+                (cell.upper.array() < lower.array()).any() || outside(cell, pa, pb) ||
+                outside(cell, pb, pc) || outside(cell, pc, pa)) {
+                continue;
+            }
+            const std::size_t first_child = 2 * index + 1;
+            if (first_child < cells_.size() && cell.end - cell.begin > 1) {
+                pending_.push_back(first_child);
+                pending_.push_back(first_child + 1);
+                continue;
+            }
+            for (std::uint32_t k = cell.begin; k < cell.end; ++k) {
+                const int p = order_[k];
+                if (in_ring_[p] && blocks(p, a, b, c)) return false;
+            }
         }
         return true;
     }
@@ -229,8 +284,11 @@ private:
     std::vector<std::array<std::uint32_t, 3>>& out_;
     bool cut_crossings_ = false;
     std::vector<Node> nodes_;
-    Eigen::Vector2d lower_;
-    double inverse_size_ = 0.0;
+    std::vector<char> in_ring_ = std::vector<char>(nodes_.size(), 1);
+    std::vector<int> order_;
+    std::vector<Cell> cells_;
+    std::vector<std::size_t> leaf_of_;
+    std::vector<std::size_t> pending_;
 };
 
 }  // namespace
