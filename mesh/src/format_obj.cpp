@@ -60,6 +60,13 @@ Expectation scan_obj(std::istream& in) {
         } else if (keyword == "vt") {
             ++texture_coordinates;
         } else if (keyword == "vn") {
+            const Element id{"normal", normals};
+            if (tokens.size() < 4)
+                problem_at_line(lines.number(), id.name() + " has fewer than 3 coordinates");
+            Eigen::Vector3f normal;
+            for (int axis = 0; axis < 3; ++axis)
+                normal[axis] = coordinate(tokens[axis + 1], lines.number(), id);
+            expect.normals.push_back(normal);
             ++normals;
         } else if (keyword == "f") {
             const Element id{"face", face};
@@ -74,6 +81,7 @@ Expectation scan_obj(std::istream& in) {
                     problem_at_line(lines.number(), id.name() + " has corner " + shown(tokens[k]) +
                                                         ", not v, v/vt, v//vn or v/vt/vn");
                 }
+                const bool has_normal = parts[2] != 0;
                 const std::size_t counts[3] = {vertices, texture_coordinates, normals};
                 const char* what[3] = {"vertex", "texture coordinate", "normal"};
                 for (int part = 0; part < 3; ++part) {
@@ -102,6 +110,8 @@ Expectation scan_obj(std::istream& in) {
                     }
                 }
                 corners.push_back(parts[0]);
+                // parts[2] is 0-based now, or still 0 when the corner names no normal.
+                expect.written_normals.push_back(has_normal ? parts[2] : -1);
             }
             expect_face(expect, corners, true);
             expect.written_starts.push_back(expect.written_corners.size());

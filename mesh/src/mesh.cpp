@@ -190,7 +190,9 @@ void Mesh::build(TriangleMeshData mesh, MeshReport report, const MeshConfig& con
     normals_.reserve(mesh.normals.size());
     for (const Eigen::Vector3d& normal : mesh.normals) normals_.push_back(normal.cast<float>());
     flat_shading_ = config.flat_shading;
-    if (!flat_shading_ && config.crease_angle < kPi) {
+    if (!flat_shading_ && config.file_normals && mesh.corner_normals.size() == triangles_.size()) {
+        corner_normals_ = std::move(mesh.corner_normals);
+    } else if (!flat_shading_ && config.crease_angle < kPi) {
         corner_normals_ = crease_normals(mesh.vertices, triangles_, config.crease_angle);
     }
     if (double_precision_) {

@@ -50,6 +50,8 @@ public:
     std::vector<Eigen::Vector3f> points;
     std::vector<int> corners;
     std::vector<std::size_t> face_starts;
+    std::vector<Eigen::Vector3f> vertex_normals;
+    std::vector<char> normal_set;
     bool bad_handle = false;
 
     OpenMesh::VertexHandle add_vertex(const OpenMesh::Vec3f& p) override {
@@ -94,8 +96,20 @@ public:
                             const std::vector<OpenMesh::Vec3f>&) override {}
     void set_face_texindex(OpenMesh::FaceHandle, int) override {}
     void set_halfedge(OpenMesh::VertexHandle, OpenMesh::HalfedgeHandle) override {}
-    void set_normal(OpenMesh::VertexHandle, const OpenMesh::Vec3f&) override {}
-    void set_normal(OpenMesh::VertexHandle, const OpenMesh::Vec3d&) override {}
+    /// PLY's nx ny nz, per vertex (asked for with Options::VertexNormal).
+    void set_normal(OpenMesh::VertexHandle vertex, const OpenMesh::Vec3f& n) override {
+        if (!vertex.is_valid() || static_cast<std::size_t>(vertex.idx()) >= points.size()) {
+            bad_handle = true;
+            return;
+        }
+        vertex_normals.resize(points.size(), Eigen::Vector3f::Zero());
+        normal_set.resize(points.size(), 0);
+        vertex_normals[static_cast<std::size_t>(vertex.idx())] = Eigen::Vector3f(n[0], n[1], n[2]);
+        normal_set[static_cast<std::size_t>(vertex.idx())] = 1;
+    }
+    void set_normal(OpenMesh::VertexHandle vertex, const OpenMesh::Vec3d& n) override {
+        set_normal(vertex, OpenMesh::Vec3f(float(n[0]), float(n[1]), float(n[2])));
+    }
     void set_color(OpenMesh::VertexHandle, const OpenMesh::Vec3uc&) override {}
     void set_color(OpenMesh::VertexHandle, const OpenMesh::Vec4uc&) override {}
     void set_color(OpenMesh::VertexHandle, const OpenMesh::Vec3f&) override {}
@@ -203,7 +217,9 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
         if (extension == ".stl") reader = &OpenMesh::IO::STLReader();
         // can_u_read also parses the header into the reader's options, which read() uses.
         if (!reader->can_u_read(name)) fail("OpenMesh's " + report.format + " reader refuses it");
+        // Vertex normals for PLY (nx ny nz); OBJ's are per corner and come from the scan.
         OpenMesh::IO::Options options;
+        if (extension == ".ply") options += OpenMesh::IO::Options::VertexNormal;
         if (!reader->read(name, importer, options)) fail("OpenMesh could not read it");
     }
     const std::size_t face_count = importer.face_count();
@@ -240,6 +256,23 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
     // distinct corners; the others must be OpenMesh's faces with their repeats put back.
     std::size_t written = 0;
     std::unordered_set<long long> seen;
+    // The file's normals: OBJ by corner (when every corner names one), PLY by vertex (when
+    // every vertex has one). A corner's normal in a triangle of an OBJ polygon is the one the
+    // polygon gave that vertex (the first, if it repeats).
+    const bool obj_normals =
+        !expect.written_normals.empty() &&
+        std::none_of(expect.written_normals.begin(), expect.written_normals.end(),
+                     [](long long index) { return index < 0; });
+    const bool ply_normals = !importer.normal_set.empty() &&
+                             importer.normal_set.size() == importer.points.size() &&
+                             std::all_of(importer.normal_set.begin(), importer.normal_set.end(),
+                                         [](char set) { return set != 0; });
+    std::vector<std::pair<std::uint32_t, long long>> normal_of;  // (vertex, normal), one face
+    auto unit = [](const Eigen::Vector3f& n) {
+        const float length = n.norm();
+        return length > 0.0f && std::isfinite(length) ? Eigen::Vector3f(n / length)
+                                                      : Eigen::Vector3f::Zero();
+    };
     auto as_written = [&](std::size_t f) {
         for (; written < expect.written_starts.size(); ++written) {
             const std::size_t begin = expect.written_starts[written];
@@ -260,6 +293,15 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
                 fail("OpenMesh's " + face_name(f) + " disagrees with the file's");
             polygon.assign(expect.written_corners.begin() + static_cast<std::ptrdiff_t>(begin),
                            expect.written_corners.begin() + static_cast<std::ptrdiff_t>(end));
+            if (obj_normals) {
+                normal_of.clear();
+                for (std::size_t c = begin; c < end; ++c) {
+                    normal_of.emplace_back(static_cast<std::uint32_t>(expect.written_corners[c]),
+                                           expect.written_normals[c]);
+                }
+                std::stable_sort(normal_of.begin(), normal_of.end(),
+                                 [](const auto& a, const auto& b) { return a.first < b.first; });
+            }
             ++written;
             return;
         }
@@ -279,7 +321,24 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
         }
         if (!expect.written_starts.empty()) as_written(f);
         report.triangulated_faces += polygon.size() > 3 ? 1 : 0;
+        const std::size_t first_triangle = mesh.triangles.size();
         if (!triangulate(polygon, mesh.vertices, mesh.triangles)) ++report.non_simple_faces;
+        if (!obj_normals && !ply_normals) continue;
+        for (std::size_t i = first_triangle; i < mesh.triangles.size(); ++i) {
+            std::array<Eigen::Vector3f, 3> normals;
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t vertex = mesh.triangles[i][k];
+                if (ply_normals) {
+                    normals[k] = unit(importer.vertex_normals[vertex]);
+                    continue;
+                }
+                const auto found = std::lower_bound(
+                    normal_of.begin(), normal_of.end(), vertex,
+                    [](const auto& entry, std::uint32_t v) { return entry.first < v; });
+                normals[k] = unit(expect.normals[static_cast<std::size_t>(found->second)]);
+            }
+            mesh.corner_normals.push_back(normals);
+        }
     }
     importer = RecordingImporter();
     const std::size_t triangle_count = mesh.triangles.size();
@@ -347,6 +406,7 @@ std::string describe(const MeshReport& report) {
     if (report.faces != 0) out << " from " << report.faces << " faces";
     if (report.triangulated_faces)
         out << " (" << report.triangulated_faces << " polygons triangulated)";
+    if (report.file_normals) out << ", normals from the file";
     if (report.welded_vertices) out << ", " << report.welded_vertices << " vertices welded";
     if (report.non_simple_faces) {
         out << ", " << report.non_simple_faces

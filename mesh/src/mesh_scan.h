@@ -179,6 +179,9 @@ struct Expectation {
     /// bridge back), so OBJ faces are triangulated as written.
     std::vector<long long> written_corners;
     std::vector<std::size_t> written_starts;
+    /// OBJ: the `vn` normals, and each written corner's normal index (0-based, -1 for none).
+    std::vector<Eigen::Vector3f> normals;
+    std::vector<long long> written_normals;
 };
 
 /// Adds one face (corner indices already validated) to the checksums. `distinct_only` mirrors

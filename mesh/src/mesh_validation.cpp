@@ -56,6 +56,14 @@ MeshReport validate_mesh(TriangleMeshData& mesh) {
     constexpr std::string_view kWhat = "validate_mesh";
     auto& vertices = mesh.vertices;
     auto& triangles = mesh.triangles;
+    // File normals travel with their triangles: a turned-over triangle swaps its last two
+    // corners' normals too. A list that does not match the triangles is dropped.
+    auto& corner_normals = mesh.corner_normals;
+    if (corner_normals.size() != triangles.size()) corner_normals.clear();
+    auto turn_over = [&](std::size_t f) {
+        std::swap(triangles[f][1], triangles[f][2]);
+        if (!corner_normals.empty()) std::swap(corner_normals[f][1], corner_normals[f][2]);
+    };
     const std::size_t vertex_count = vertices.size();
     for (std::size_t v = 0; v < vertex_count; ++v) {
         if (!vertices[v].allFinite()) require(false, kWhat, vertex_name(v), "finite", vertices[v]);
@@ -172,7 +180,7 @@ MeshReport validate_mesh(TriangleMeshData& mesh) {
     for (std::size_t f = 0; f < triangle_count; ++f) {
         const std::uint32_t c = component[f];
         flip[f] = c != kNone && component_orientable[c] && flip[f] != component_invert[c];
-        if (flip[f]) std::swap(triangles[f][1], triangles[f][2]);
+        if (flip[f]) turn_over(f);
     }
     report.is_closed =
         report.boundary_edges == 0 && report.non_manifold_edges == 0 && report.orientable;
@@ -220,7 +228,7 @@ MeshReport validate_mesh(TriangleMeshData& mesh) {
         }
         for (std::size_t f = 0; f < triangle_count; ++f) {
             if (component[f] == kNone || !outward_negative[component[f]]) continue;
-            std::swap(triangles[f][1], triangles[f][2]);
+            turn_over(f);
             flip[f] ^= 1;
         }
         for (std::size_t c = 0; c < component_count; ++c) {
@@ -238,12 +246,15 @@ MeshReport validate_mesh(TriangleMeshData& mesh) {
         const Eigen::Vector3d area =
             (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]);
         if (repeated(t) || area.squaredNorm() == 0.0) continue;
+        if (!corner_normals.empty()) corner_normals[kept] = corner_normals[f];
         triangles[kept++] = t;
     }
+    if (!corner_normals.empty()) corner_normals.resize(kept);
     report.degenerate_triangles = triangle_count - kept;
     triangles.resize(kept);
     triangles.shrink_to_fit();
     report.triangles = kept;
+    report.file_normals = !corner_normals.empty();
     require(kept > 0, kWhat, "count of triangles with non-zero area", "> 0", kept);
 
     // Angle-weighted vertex normals: each triangle adds its unit normal times its angle at the

@@ -5,6 +5,8 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "csgrt/mesh/mesh.h"
 #include "csgrt/mesh/mesh_tools.h"
@@ -169,6 +171,175 @@ TEST(SmoothShading, ACreaseAngleKeepsACubesEdgesSharpAndFlatShadingUsesTheFace) 
         if (!a) continue;
         // Vertex normals and corner normals come from the same sums, in float: 1e-6.
         EXPECT_NEAR((a->shading_normal - b->shading_normal).norm(), 0.0, 1e-6);
+    }
+}
+
+/// The shading normal a hit must have: the corner normals `normal_at(k)` of the hit triangle
+/// interpolated by the hit point's barycentrics (long double, from the stored corners).
+template <class NormalAt>
+Eigen::Matrix<long double, 3, 1> interpolated(const Mesh& mesh, const Hit& hit,
+                                              NormalAt&& normal_at) {
+    using LongVector = Eigen::Matrix<long double, 3, 1>;
+    const LongVector a = mesh.corner(hit.primitive_id, 0).cast<long double>();
+    const LongVector b = mesh.corner(hit.primitive_id, 1).cast<long double>();
+    const LongVector c = mesh.corner(hit.primitive_id, 2).cast<long double>();
+    const LongVector p = hit.point.cast<long double>();
+    const LongVector n = (b - a).cross(c - a);
+    const long double u = (p - a).cross(c - a).dot(n) / n.squaredNorm();
+    const long double v = (b - a).cross(p - a).dot(n) / n.squaredNorm();
+    const LongVector n0 = normal_at(0).template cast<long double>();
+    const LongVector n1 = normal_at(1).template cast<long double>();
+    const LongVector n2 = normal_at(2).template cast<long double>();
+    return ((1.0L - u - v) * n0 + u * n1 + v * n2).normalized();
+}
+
+std::filesystem::path temporary_file(const std::string& stem, const std::string& extension) {
+    return std::filesystem::temp_directory_path() /
+           ("csgrt_" + stem + "_" +
+            std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + extension);
+}
+
+TEST(FileNormals, ObjCornerNormalsAreInterpolatedAndFollowAFlippedTriangle) {
+    // A coarse sphere written as OBJ with its own normal at every corner of every face: the
+    // vertex's direction tilted by a random vector per corner, so that one vertex has a
+    // different normal in each face (a per-vertex reading would keep only one of them). Face 5
+    // is written the wrong way round; validation turns it over, and its corner normals must
+    // turn with its corners.
+    const test::TestMesh sphere = test::sphere_mesh(1);
+    test::Random random(16);
+    std::vector<std::array<Eigen::Vector3f, 3>> written(sphere.triangles.size());
+    std::vector<std::array<std::uint32_t, 3>> faces = sphere.triangles;
+    std::swap(faces[5][1], faces[5][2]);
+    const std::filesystem::path path = temporary_file("normals", ".obj");
+    {
+        std::ofstream out(path);
+        out.precision(9);
+        for (const Eigen::Vector3d& p : sphere.vertices)
+            out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+        for (std::size_t f = 0; f < faces.size(); ++f) {
+            for (int k = 0; k < 3; ++k) {
+                const Eigen::Vector3d n =
+                    (sphere.vertices[faces[f][k]] + 0.4 * random.unit_vector()).normalized();
+                // As the loader keeps it: the float, normalised.
+                written[f][k] = n.cast<float>().normalized();
+                out << "vn " << n.x() << " " << n.y() << " " << n.z() << "\n";
+            }
+        }
+        for (std::size_t f = 0; f < faces.size(); ++f) {
+            out << "f";
+            for (int k = 0; k < 3; ++k) out << " " << faces[f][k] + 1 << "//" << 3 * f + k + 1;
+            out << "\n";
+        }
+    }
+    const std::shared_ptr<Mesh> mesh = Mesh::load(path);
+    MeshConfig computed_config;
+    computed_config.file_normals = false;
+    const std::shared_ptr<Mesh> computed = Mesh::load(path, computed_config);
+    std::filesystem::remove(path);
+    EXPECT_TRUE(mesh->report().file_normals);
+    EXPECT_EQ(mesh->report().flipped_triangles, 1u);
+    EXPECT_NE(describe(mesh->report()).find("normals from the file"), std::string::npos);
+    int checked = 0, differ_from_computed = 0, flipped_face = 0;
+    for (int r = 0; r < 600; ++r) {
+        const Point3 origin = 3.0 * random.unit_vector();
+        const Ray ray{origin, 0.3 * random.unit_vector() - origin};
+        const std::optional<Hit> hit = mesh->intersect(ray);
+        if (!hit) continue;
+        const std::size_t f = hit->primitive_id;  // no triangle dropped: faces keep their order
+        const auto& triangle = mesh->triangle(f);
+        // The written normal of the face's corner at the same vertex, wherever validation put
+        // that corner.
+        static const Eigen::Vector3f kZero = Eigen::Vector3f::Zero();
+        auto normal_at = [&](int k) -> const Eigen::Vector3f& {
+            for (int j = 0; j < 3; ++j) {
+                if (faces[f][j] == triangle[k]) return written[f][j];
+            }
+            ADD_FAILURE() << "vertex " << triangle[k] << " is not a corner of face " << f;
+            return kZero;
+        };
+        const auto expected = interpolated(*mesh, *hit, normal_at);
+        // Float normals and barycentrics: a few 1e-7 (as for computed normals above).
+        EXPECT_NEAR((hit->shading_normal.cast<long double>() - expected).norm(), 0.0L, 1e-5L)
+            << "triangle " << f;
+        const std::optional<Hit> other = computed->intersect(ray);
+        if (other && (other->shading_normal - hit->shading_normal).norm() > 1e-2)
+            ++differ_from_computed;
+        flipped_face += f == 5;
+        ++checked;
+    }
+    EXPECT_GT(checked, 400);
+    EXPECT_GT(differ_from_computed, checked / 2);
+    EXPECT_GT(flipped_face, 0);
+}
+
+TEST(FileNormals, PlyVertexNormalsAreInterpolatedAndPartialObjNormalsAreNotUsed) {
+    const test::TestMesh sphere = test::sphere_mesh(1);
+    test::Random random(23);
+    std::vector<Eigen::Vector3f> vertex_normals;
+    const std::filesystem::path ply = temporary_file("normals", ".ply");
+    {
+        std::ofstream out(ply);
+        out.precision(9);
+        out << "ply\nformat ascii 1.0\nelement vertex " << sphere.vertices.size()
+            << "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\n"
+               "property float ny\nproperty float nz\nelement face "
+            << sphere.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+        for (const Eigen::Vector3d& p : sphere.vertices) {
+            // Not unit length: the loader normalises them.
+            const Eigen::Vector3d n = 2.5 * (p + 0.5 * random.unit_vector()).normalized();
+            vertex_normals.push_back(n.cast<float>().normalized());
+            out << p.x() << " " << p.y() << " " << p.z() << " " << n.x() << " " << n.y() << " "
+                << n.z() << "\n";
+        }
+        for (const auto& t : sphere.triangles)
+            out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+    }
+    const std::shared_ptr<Mesh> mesh = Mesh::load(ply);
+    std::filesystem::remove(ply);
+    EXPECT_TRUE(mesh->report().file_normals);
+    int checked = 0;
+    for (int r = 0; r < 300; ++r) {
+        const Point3 origin = 3.0 * random.unit_vector();
+        const Ray ray{origin, 0.3 * random.unit_vector() - origin};
+        const std::optional<Hit> hit = mesh->intersect(ray);
+        if (!hit) continue;
+        const auto& triangle = mesh->triangle(hit->primitive_id);
+        const auto expected = interpolated(*mesh, *hit, [&](int k) -> const Eigen::Vector3f& {
+            return vertex_normals[triangle[k]];
+        });
+        EXPECT_NEAR((hit->shading_normal.cast<long double>() - expected).norm(), 0.0L, 1e-5L);
+        ++checked;
+    }
+    EXPECT_GT(checked, 200);
+
+    // An OBJ whose faces name normals for some corners only: the file's normals are not used
+    // (the report says so) and shading is the computed vertex normals'.
+    const std::filesystem::path obj = temporary_file("partial_normals", ".obj");
+    {
+        std::ofstream out(obj);
+        for (const Eigen::Vector3d& p : sphere.vertices)
+            out << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+        out << "vn 1 0 0\n";
+        for (std::size_t f = 0; f < sphere.triangles.size(); ++f) {
+            const auto& t = sphere.triangles[f];
+            out << "f " << t[0] + 1 << (f == 0 ? "//1 " : " ") << t[1] + 1 << " " << t[2] + 1
+                << "\n";
+        }
+    }
+    const std::shared_ptr<Mesh> partial = Mesh::load(obj);
+    std::filesystem::remove(obj);
+    EXPECT_FALSE(partial->report().file_normals);
+    const Mesh plain(TriangleMeshData{sphere.vertices, sphere.triangles, {}, {}});
+    for (int r = 0; r < 100; ++r) {
+        const Point3 origin = 3.0 * random.unit_vector();
+        const Ray ray{origin, 0.3 * random.unit_vector() - origin};
+        const std::optional<Hit> a = partial->intersect(ray);
+        const std::optional<Hit> b = plain.intersect(ray);
+        ASSERT_EQ(a.has_value(), b.has_value());
+        // The file's float coordinates against the doubles: normals agree to float rounding.
+        if (a) {
+            EXPECT_NEAR((a->shading_normal - b->shading_normal).norm(), 0.0, 1e-5);
+        }
     }
 }
 

@@ -12,9 +12,9 @@
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/accelerator_config.h"
 #include "csgrt/accel/factory.h"
-#include "csgrt/mesh/mesh_io.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/shape.h"
+#include "csgrt/mesh/mesh_io.h"
 
 namespace csgrt {
 
@@ -39,6 +39,11 @@ struct MeshConfig {
     /// faces at its vertex within the angle of its own face, so edges sharper than the angle
     /// stay sharp. Pi (the default) joins every face (plain vertex normals).
     double crease_angle = kPi;
+    /// Shade with the normals the file stores (OBJ `vn`, PLY `nx ny nz`;
+    /// TriangleMeshData::corner_normals) when it has one for every corner, interpolated by the
+    /// barycentrics like computed ones; they take the place of the crease angle. False
+    /// computes normals as for a file without them.
+    bool file_normals = true;
 };
 
 /// A triangle mesh as one shape: its triangles in a TriangleSet (float by default, double on

@@ -31,6 +31,11 @@ struct TriangleMeshData {
     /// triangle uses or whose triangles' normals cancel. Filled by `validate_mesh` (and so by
     /// `load_mesh`).
     std::vector<Eigen::Vector3d> normals;
+    /// Normals the file stores (OBJ `vn` by face corner, PLY `nx ny nz` by vertex), one per
+    /// triangle corner in the order of `triangles`, unit or zero; empty when the file has none,
+    /// or not for every corner. A Mesh shades with them instead of `normals`
+    /// (MeshConfig::file_normals). validate_mesh keeps them with their triangles.
+    std::vector<std::array<Eigen::Vector3f, 3>> corner_normals = {};
 };
 
 /// What loading and validation found and repaired (docs/meshes.md lists the rules).
@@ -51,6 +56,8 @@ struct MeshReport {
     /// from one corner, so their triangles' area may differ from the polygon's. A keyhole (a
     /// hole joined by a bridge whose corners repeat) is simple enough and is not counted.
     std::size_t non_simple_faces = 0;
+    /// Whether the file gave a normal for every corner (TriangleMeshData::corner_normals).
+    bool file_normals = false;
     /// Vertices merged into another at the same position (MeshConfig::weld_vertices).
     std::size_t welded_vertices = 0;
     std::size_t vertices = 0;
