@@ -87,6 +87,7 @@ Hit finish_along_path(const Ray& ray, const HitRecord& record, std::uint32_t pat
 Hit finish_hit(const Ray& ray, const HitRecord& record, const QueryScratch& scratch) {
     Hit hit = finish_along_path(ray, record, record.instance_path, scratch);
     hit.object_id = record.object;
+    if (record.material != kNoPaintedMaterial) hit.material = record.material;
     if (record.flip_normal) {
         hit.geometric_normal = -hit.geometric_normal;
         hit.shading_normal = -hit.shading_normal;

@@ -9,6 +9,7 @@
 #include "csgrt/core/instance.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/compound.h"
+#include "csgrt/csg/painted.h"
 #include "csgrt/mesh/mesh.h"
 
 namespace csgrt {
@@ -25,6 +26,9 @@ std::vector<ShapePointer> shared_children(const ShapePointer& shape) {
     }
     if (const auto* boolean = dynamic_cast<const Boolean*>(shape.get())) {
         return {boolean->shared_first(), boolean->shared_second()};
+    }
+    if (const auto* painted = dynamic_cast<const Painted*>(shape.get())) {
+        return {painted->shared_shape()};
     }
     if (const auto* compound = dynamic_cast<const Compound*>(shape.get())) {
         std::vector<ShapePointer> children;
@@ -106,6 +110,9 @@ private:
         }
         if (const auto* boolean = dynamic_cast<const Boolean*>(shape.get())) {
             return std::make_shared<Boolean>(boolean->operation(), parts[0], parts[1]);
+        }
+        if (const auto* painted = dynamic_cast<const Painted*>(shape.get())) {
+            return std::make_shared<Painted>(parts[0], painted->material());
         }
         return shape;
     }

@@ -55,10 +55,15 @@ struct RayTally {
     }
 };
 
-const Material& material_of(const Scene& scene, std::uint32_t object_id) {
+/// The material of the surface hit: the one a Painted shape on its path gave it (a CSG
+/// operand's, csg/painted.h), else its scene object's.
+const Material& material_of(const Scene& scene, const Hit& hit) {
     static const Material kDefault;
-    if (object_id >= scene.objects().size()) return kDefault;
-    const std::uint32_t material = scene.objects()[object_id].material;
+    std::uint32_t material = hit.material;
+    if (material == kNoIndex) {
+        if (hit.object_id >= scene.objects().size()) return kDefault;
+        material = scene.objects()[hit.object_id].material;
+    }
     if (material >= scene.materials().size()) return kDefault;
     return scene.materials()[material];
 }
@@ -76,7 +81,7 @@ Vector3 background_of(const Frame& frame) {
 /// Linear radiance leaving `hit` toward the camera along `ray` (unit direction).
 Vector3 shade(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
               RayTally& tally) {
-    const Material& material = material_of(frame.scene, hit.object_id);
+    const Material& material = material_of(frame.scene, hit);
     const Vector3& albedo = material.albedo;
     const Vector3 view = -ray.direction;
     // Both sides of every surface are shaded: turn the normals to the side the ray came from.
@@ -182,7 +187,7 @@ Ray spawned_ray(const Hit& hit, const Normal3& side, const Vector3& direction) {
 /// reflection and refraction; other materials by direct light (shade) plus mirror reflection.
 Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryScratch& scratch,
                       RayTally& tally, int depth) {
-    const Material& material = material_of(frame.scene, hit.object_id);
+    const Material& material = material_of(frame.scene, hit);
     const Vector3& direction = ray.direction;
     if (material.ior > 0.0) {
         // The surface's own normal is outward (CSG results included), so its sign says whether

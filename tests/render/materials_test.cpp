@@ -7,6 +7,8 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/core/shapes.h"
+#include "csgrt/csg/boolean.h"
+#include "csgrt/csg/painted.h"
 #include "csgrt/csg/scene.h"
 #include "csgrt/csg/scene_file.h"
 #include "csgrt/render/renderer.h"
@@ -286,6 +288,45 @@ TEST(MaterialKeys, TheSceneFileReadsAndChecksThem) {
                 << error.what();
         }
     }
+}
+
+TEST(CsgMaterials, EachOperandShowsItsOwnAndACutShowsTheSubtractedOne) {
+    // The unit box (red) minus a ball at its corner (blue) and minus a thin slot (unpainted),
+    // in an object whose material is green. Seen from above, orthographically, lit from the
+    // eye: the box's top face is red, the bite's cut is blue, the slot's cut takes the
+    // object's green (docs/rendering.md, "Materials in CSG").
+    Scene scene;
+    const auto red = scene.add_material(Material{"red", Vector3(1, 0, 0)});
+    const auto blue = scene.add_material(Material{"blue", Vector3(0, 0, 1)});
+    const auto green = scene.add_material(Material{"green", Vector3(0, 1, 0)});
+    const auto box =
+        std::make_shared<Painted>(std::make_shared<Box>(Point3(0, 0, 0), Point3(1, 1, 1)), red);
+    const auto ball =
+        std::make_shared<Painted>(std::make_shared<Sphere>(Point3(1, 1, 1), 0.5), blue);
+    const auto slot = std::make_shared<Box>(Point3(0.1, 0.4, 0.5), Point3(0.2, 0.6, 2));
+    scene.add_object(make_difference(box, {ball, slot}), green);
+    Camera camera;
+    camera.projection = Camera::Projection::Orthographic;
+    camera.position = Point3(0.5, 0.5, 5);
+    camera.look_at = Point3(0.5, 0.5, 0);
+    camera.orthographic_height = 1.0;
+    scene.set_camera(camera);
+    scene.commit();
+    RenderSettings settings;
+    settings.width = 10;
+    settings.height = 10;
+    const Image image = render(scene, settings).image;
+    // Pixel (x, y) looks down at (0.05 + 0.1 x, 0.95 - 0.1 y).
+    auto colour = [&](int x, int y) {
+        const Pixel& pixel = image.at(x, y);
+        return Vector3(pixel.red, pixel.green, pixel.blue);
+    };
+    EXPECT_EQ(colour(3, 7), Vector3(1, 0, 0));  // (0.35, 0.25): the top face, facing up
+    const Vector3 cut = colour(9, 0);           // (0.95, 0.95): inside the bite
+    EXPECT_EQ(cut.x(), 0.0);
+    EXPECT_EQ(cut.y(), 0.0);
+    EXPECT_GT(cut.z(), 0.5);
+    EXPECT_EQ(colour(1, 5), Vector3(0, 1, 0));  // (0.15, 0.45): the slot's floor, at z = 0.5
 }
 
 }  // namespace

@@ -8,6 +8,11 @@ namespace csgrt {
 
 class Shape;
 
+/// HitRecord::material of a hit no Painted shape (csg/painted.h) has given a material; painted
+/// materials are indices below it.
+inline constexpr std::uint16_t kNoPaintedMaterial = 0xFFFF;
+inline constexpr std::uint32_t kMaxPaintedMaterial = kNoPaintedMaterial - 1;
+
 /// What a query knows about a hit before it is shaded: the parameter t, the leaf surface, and
 /// what that surface needs to finish the hit later (a primitive index and a local parameter
 /// such as a triangle's barycentrics). Queries keep only these 40 bytes while they search;
@@ -31,7 +36,11 @@ struct HitRecord {
     /// Set by CSG difference on surfaces of a subtracted solid: their outward normal is the
     /// result's inward normal.
     bool flip_normal = false;
+    /// The material the innermost Painted shape on the hit's path gave it (an index into the
+    /// scene's materials), or kNoPaintedMaterial. Fits the record's padding: still 40 bytes.
+    std::uint16_t material = kNoPaintedMaterial;
 };
+static_assert(sizeof(HitRecord) == 40, "the material fits the record's padding");
 
 /// The point error `finish_hit` gives a hit on a double-precision leaf, in units of the unit
 /// roundoff times the largest coordinate magnitude the leaf's computation saw (the point, the
@@ -71,6 +80,9 @@ struct Hit {
     std::uint32_t primitive_id = kNoIndex;
     /// The scene object the hit belongs to (set by the scene; kNoIndex for a bare shape).
     std::uint32_t object_id = kNoIndex;
+    /// The material a Painted shape gave the surface (HitRecord::material), or kNoIndex: the
+    /// scene object's.
+    std::uint32_t material = kNoIndex;
     /// True when the ray arrives on the side the geometric normal points to.
     bool front_face = true;
 };

@@ -12,7 +12,8 @@ namespace csgrt {
 
 /// A copy of `scene` in which every structure (the top level's, each compound's, each mesh's)
 /// is `structure`, built anew and committed: what the scene would cost if it used that one
-/// structure throughout. Instances, booleans, compounds and meshes are rebuilt around their
+/// structure throughout. Instances, booleans, painted shapes, compounds and meshes are rebuilt
+/// around their
 /// rebuilt children; leaves, and shapes with no structure below them, are shared with `scene`,
 /// and a shape shared within `scene` stays shared. A mesh is rebuilt from its stored triangles
 /// (for a float mesh, the float corners: the same geometry). Materials, lights and camera are
