@@ -39,6 +39,7 @@ BEYOND_THE_SCHEMA = {
     "torus_radii.json": "minor_radius < major_radius compares two values",
     "unknown_definition.json": "references to definitions",
     "unknown_material.json": "references to materials",
+    "nested_material.json": "references to materials",
     "light_rectangle_parallel_edges.json": "parallel edges compare two vectors",
     "array_copy_material_nested.json": "an array node is one definition, top level or nested",
     "array_copy_unknown_material.json": "references to materials",

@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "csgrt/core/error.h"
 #include "csgrt/core/shapes.h"
@@ -327,6 +329,41 @@ TEST(CsgMaterials, EachOperandShowsItsOwnAndACutShowsTheSubtractedOne) {
     EXPECT_EQ(cut.y(), 0.0);
     EXPECT_GT(cut.z(), 0.5);
     EXPECT_EQ(colour(1, 5), Vector3(0, 1, 0));  // (0.15, 0.45): the slot's floor, at z = 0.5
+}
+
+TEST(CsgMaterials, TheSceneFileGivesOperandsTheirMaterials) {
+    // The docs' stone box with a gold-lined bite, plus a definition carrying its own material
+    // inside a union whose other operand has none.
+    const Scene scene = load_scene_from_string(R"({
+      "materials": {"stone": {"albedo": 0.5}, "gold": {"albedo": [0.9, 0.7, 0.2]},
+                    "blue": {"albedo": [0.1, 0.2, 0.9]}},
+      "definitions": {"blue ball": {"type": "sphere", "radius": 0.5, "material": "blue"}},
+      "objects": [
+        {"type": "difference", "material": "stone", "operands": [
+          {"type": "box", "lower": [-1, -1, -1], "upper": [1, 1, 1]},
+          {"type": "sphere", "center": [1, 1, 1], "radius": 1, "material": "gold"}]},
+        {"type": "union", "operands": [
+          {"type": "ref", "definition": "blue ball", "transform": [{"translate": [4, 0, 0]}]},
+          {"type": "sphere", "center": [5, 0, 0], "radius": 0.5}]}]})",
+                                               "csg_materials.json");
+    Scene committed = scene;
+    committed.commit();
+    QueryScratch scratch;
+    auto material_seen = [&](double x, double y) {
+        Ray ray;
+        ray.origin = Point3(x, y, 10);
+        ray.direction = Vector3(0, 0, -1);
+        const std::optional<Hit> hit = committed.intersect(ray, scratch);
+        EXPECT_TRUE(hit) << x << ", " << y;
+        if (!hit || hit->material == kNoIndex) return std::string("object's");
+        return committed.materials()[hit->material].name;
+    };
+    EXPECT_EQ(material_seen(-0.5, -0.5), "object's");  // the box's top: the object's stone
+    EXPECT_EQ(committed.materials()[committed.objects()[0].material].name, "stone");
+    EXPECT_EQ(material_seen(0.8, 0.8), "gold");  // the bite
+    EXPECT_EQ(material_seen(4.0, 0.0), "blue");  // the definition's own
+    EXPECT_EQ(material_seen(5.3, 0.0), "object's");
+    EXPECT_EQ(committed.objects()[0].shape->children()[1]->kind(), "painted");
 }
 
 }  // namespace

@@ -55,8 +55,12 @@ void Fields::finish() const {
     for (auto it = value_.begin(); it != value_.end(); ++it) {
         if (std::find(asked_.begin(), asked_.end(), it.key()) != asked_.end()) continue;
         std::string message = "unknown key " + quote_name(it.key()) + " in " + what_;
-        if (it.key() == "material" || it.key() == "name") {
-            message += " (\"" + it.key() + "\" belongs to the top-level objects)";
+        if (it.key() == "name") {
+            message += " (\"name\" belongs to the top-level objects)";
+        } else if (it.key() == "material") {
+            message +=
+                " (\"material\" of a grid, an array or their copies belongs to the "
+                "top-level objects; inside a shape, give the item its material)";
         } else if (it.key() == "materials" || it.key() == "material_ramp") {
             message += " (\"" + it.key() + "\" belongs to top-level grids and arrays)";
         }

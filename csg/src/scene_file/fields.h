@@ -31,6 +31,10 @@ public:
         ask(key);
         return value_.contains(key);
     }
+    /// Whether `key` was asked for already.
+    bool asked(std::string_view key) const {
+        return std::find(asked_.begin(), asked_.end(), key) != asked_.end();
+    }
 
     /// The raw value of a required key.
     const Json& required(std::string_view key, std::string_view expected);

@@ -5,6 +5,7 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/csg/compound.h"
+#include "csgrt/csg/painted.h"
 #include "limits.h"
 #include "loader.h"
 
@@ -47,6 +48,12 @@ ShapePointer Loader::shape(Fields& fields) {
                         "the transformed shape's bounds overflow a double (1.8e308); the shape "
                         "would vanish");
         }
+    }
+    // Below a top-level object (whose "material" was read as the object's), a node may name a
+    // material of its own; its surfaces keep it through the CSG tree (csg/painted.h).
+    if (!fields.asked("material") && fields.has("material")) {
+        built = std::make_shared<Painted>(
+            std::move(built), material_named(fields, "material", fields.string("material")));
     }
     return built;
 }
