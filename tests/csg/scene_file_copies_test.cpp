@@ -133,6 +133,70 @@ TEST(SceneFileCopies, ArrayCopiesTakeTheirOwnTransformsAndMaterials) {
     EXPECT_EQ(counts.by_kind.at("box"), 1u);
 }
 
+TEST(SceneFileCopies, AGridOrArrayInsideAShapePaintsEachCopyWithItsMaterial) {
+    // A box (the object's material "stone") minus a row of three balls centred on its top
+    // face, their materials cycling a, b; a union with an array whose second copy names its
+    // own; a nested grid under a ramp; a top-level grid over a nested grid naming none.
+    Scene scene = load(R"({"materials": {"stone": {"albedo": 0.5}, "a": {"albedo": 0.2},
+        "b": {"albedo": 0.4}, "cold": {"albedo": [0, 0, 1]}, "hot": {"albedo": [1, 0, 0]}},
+      "objects": [
+        {"type": "difference", "material": "stone", "operands": [
+          {"type": "box", "lower": [-6, -1, -1], "upper": [6, 1, 1]},
+          {"type": "grid", "count": [3, 1, 1], "spacing": [4, 0, 0], "materials": ["a", "b"],
+           "transform": [{"translate": [0, 1, 0]}],
+           "item": {"type": "sphere", "radius": 0.5}}]},
+        {"type": "union", "operands": [{"type": "box", "lower": [-1, 9, -1], "upper": [1, 11, 1]},
+          {"type": "array", "material": "a", "item": {"type": "sphere", "radius": 1},
+           "copies": [{"transform": [{"translate": [3, 10, 0]}]},
+                      {"transform": [{"translate": [-3, 10, 0]}], "material": "b"}]}]},
+        {"type": "compound", "children": [
+          {"type": "grid", "count": [3, 1, 1], "spacing": [4, 0, 0],
+           "material_ramp": ["cold", "hot"], "transform": [{"translate": [0, 20, 0]}],
+           "item": {"type": "sphere", "radius": 1}}]},
+        {"type": "grid", "count": [2, 1, 1], "spacing": [4, 0, 0], "material": "b",
+         "transform": [{"translate": [0, 30, 0]}],
+         "item": {"type": "compound", "children": [
+           {"type": "grid", "count": [1, 1, 1], "spacing": [0, 0, 0],
+            "item": {"type": "sphere", "radius": 1}}]}}]})");
+    scene.commit();
+    QueryScratch scratch;
+    const auto material_of = [&](const Ray& ray) -> std::string {
+        const auto hit = scene.intersect(ray, scratch);
+        if (!hit) return "miss";
+        const std::uint32_t index =
+            hit->material != kNoIndex ? hit->material : scene.objects()[hit->object_id].material;
+        return scene.materials()[index].name;
+    };
+    const auto material_at = [&](double x, double y) {
+        return material_of(Ray{Point3(x, y, 10), Vector3(0, 0, -1)});
+    };
+    // Object 0, from above: at x = -4, 0, 4 the top face is inside a ball, so the ray meets
+    // the ball's lower half at y = 0.5, the cut, which shows the subtracted ball's material;
+    // between the balls, the box's own face.
+    const auto from_above = [&](double x) {
+        return material_of(Ray{Point3(x, 5, 0), Vector3(0, -1, 0)});
+    };
+    EXPECT_EQ(from_above(-4.0), "a");
+    EXPECT_EQ(from_above(0.0), "b");
+    EXPECT_EQ(from_above(4.0), "a");
+    EXPECT_EQ(from_above(2.0), "stone");
+    EXPECT_EQ(scene.intersect(Ray{Point3(0, 5, 0), Vector3(0, -1, 0)}, scratch)->t, 4.5);
+    // Object 1: the box takes the object's default; the copies a and, on its own, b.
+    EXPECT_EQ(material_at(0.0, 10.0), "default");
+    EXPECT_EQ(material_at(3.0, 10.0), "a");
+    EXPECT_EQ(material_at(-3.0, 10.0), "b");
+    // Object 2: the ramp's blends, one new material per copy, as at the top level.
+    EXPECT_EQ(material_at(-4.0, 20.0), "cold..hot[0]");
+    EXPECT_EQ(material_at(0.0, 20.0), "cold..hot[1]");
+    EXPECT_EQ(material_at(4.0, 20.0), "cold..hot[2]");
+    EXPECT_EQ(scene.materials()[7].albedo, Vector3(0.5, 0, 0.5));
+    // Objects 3 and 4: a top-level grid's material is the objects'; the grid nested in its
+    // item named none, so its copy is not painted and the object's shows.
+    EXPECT_EQ(material_at(-2.0, 30.0), "b");
+    EXPECT_EQ(scene.objects()[3].material, scene.objects()[4].material);
+    EXPECT_EQ(count_scene_shapes(scene).by_kind.at("painted"), 3u + 2u + 3u);
+}
+
 TEST(SceneFileCopies, TenThousandObjectsEachTurnedAndColouredFromASmallFile) {
     const std::string text = R"({"materials": {"cold": {"albedo": [0.1, 0.2, 0.9]},
         "hot": {"albedo": [0.9, 0.2, 0.1]}},

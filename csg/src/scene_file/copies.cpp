@@ -1,8 +1,10 @@
 // Grids and arrays: nodes that stand for copies of one item, each moved into place (a grid's
-// cells, an array's listed transforms), and at the top level each with its material.
+// cells, an array's listed transforms), each with its material: at the top level the object's,
+// inside a shape painted on the copy.
 
 #include <algorithm>
 
+#include "csgrt/core/hit.h"
 #include "limits.h"
 #include "loader.h"
 
@@ -62,51 +64,55 @@ std::uint32_t Loader::material_named(Fields& fields, std::string_view key,
 std::vector<Copy> Loader::copies(Fields& fields, bool top_level) {
     const std::string type = fields.string("type");
     fields.set_what(with_article(type));
-    // A top-level node's materials are read before its copies are built (docs/scene-format.md,
+    // The node's materials are read before its copies are built (docs/scene-format.md,
     // "Grids and arrays"): one for all, a palette cycled, or a ramp blended across the copies.
     std::vector<std::uint32_t> palette;
-    bool ramp = false;
-    if (top_level) {
-        std::string_view given;
-        for (const std::string_view key : {"material", "materials", "material_ramp"}) {
-            if (!fields.has(key)) continue;
-            if (!given.empty()) {
-                std::string message = "expected one of \"material\", \"materials\" or ";
-                message.append("\"material_ramp\", not both \"").append(given);
-                fields.fail(given, message.append("\" and \"").append(key).append("\""));
-            }
-            given = key;
+    std::string_view given;
+    for (const std::string_view key : {"material", "materials", "material_ramp"}) {
+        if (!fields.has(key)) continue;
+        if (!given.empty()) {
+            std::string message = "expected one of \"material\", \"materials\" or ";
+            message.append("\"material_ramp\", not both \"").append(given);
+            fields.fail(given, message.append("\" and \"").append(key).append("\""));
         }
-        ramp = given == "material_ramp";
-        if (given.empty() || given == "material") {
-            palette.push_back(
-                material_named(fields, "material", fields.string("material", "default")));
-        } else {
-            const std::string at = fields.pointer(given);
-            const Json& names = fields.array(given, ramp ? 2 : 1, "material names");
-            for (std::size_t m = 0; m < names.size(); ++m) {
-                if (!names[m].is_string()) {
-                    source_.fail(child_pointer(at, m),
-                                 "expected a material name, got " + describe(names[m]));
-                }
-                palette.push_back(material_named(fields, given, names[m].get<std::string>()));
-                if (ramp && scene_->materials()[palette.back()].ior !=
-                                scene_->materials()[palette.front()].ior) {
-                    source_.fail(child_pointer(at, m),
-                                 "expected materials of one index of refraction (\"ior\") in a "
-                                 "ramp: glass does not blend into paint");
-                }
+        given = key;
+    }
+    const bool ramp = given == "material_ramp";
+    if (given == "material" || (given.empty() && top_level)) {
+        // A top-level node that names none gives its copies the default material; a nested
+        // one leaves them to the materials around them.
+        palette.push_back(material_named(fields, "material", fields.string("material", "default")));
+    } else if (!given.empty()) {
+        const std::string at = fields.pointer(given);
+        const Json& names = fields.array(given, ramp ? 2 : 1, "material names");
+        for (std::size_t m = 0; m < names.size(); ++m) {
+            if (!names[m].is_string()) {
+                source_.fail(child_pointer(at, m),
+                             "expected a material name, got " + describe(names[m]));
+            }
+            palette.push_back(material_named(fields, given, names[m].get<std::string>()));
+            if (ramp && scene_->materials()[palette.back()].ior !=
+                            scene_->materials()[palette.front()].ior) {
+                source_.fail(child_pointer(at, m),
+                             "expected materials of one index of refraction (\"ior\") in a "
+                             "ramp: glass does not blend into paint");
             }
         }
     }
-    std::vector<Copy> made = type == "grid" ? grid(fields) : array(fields, top_level);
-    for (std::size_t c = 0; c < made.size(); ++c) {
-        if (!top_level || made[c].has_own_material) continue;
-        if (!ramp) {
-            made[c].material = palette[c % palette.size()];
-            continue;
-        }
-        // Copy c sits at c / (n - 1) along the ramp, between two of its materials.
+    std::vector<Copy> made = type == "grid" ? grid(fields) : array(fields);
+    if (ramp && !top_level &&
+        scene_->materials().size() + made.size() > std::size_t{kMaxPaintedMaterial} + 1) {
+        // Refused before the materials are made: a ramp makes one per copy.
+        fields.fail("material_ramp",
+                    "a ramp inside a shape makes one material per copy, and " +
+                        std::to_string(made.size()) + " copies after the scene's " +
+                        std::to_string(scene_->materials().size()) + " materials pass the " +
+                        std::to_string(kMaxPaintedMaterial + 1) +
+                        " a surface inside a shape may name (a hit keeps it in 16 bits); "
+                        "put the grid at the top level, where copies are objects");
+    }
+    // Copy c of a ramp sits at c / (n - 1) along it, between two of its materials.
+    const auto ramp_material = [&](std::size_t c) {
         const double position = made.size() == 1 ? 0.0
                                                  : static_cast<double>(c) /
                                                        static_cast<double>(made.size() - 1) *
@@ -117,7 +123,17 @@ std::vector<Copy> Loader::copies(Fields& fields, bool top_level) {
                   position - static_cast<double>(below));
         blended.name = scene_->materials()[palette.front()].name + ".." +
                        scene_->materials()[palette.back()].name + "[" + std::to_string(c) + "]";
-        made[c].material = scene_->add_material(std::move(blended));
+        return scene_->add_material(std::move(blended));
+    };
+    for (std::size_t c = 0; c < made.size(); ++c) {
+        if (!made[c].has_own_material) {
+            if (palette.empty()) continue;  // nested and no material named: left unpainted
+            made[c].material = ramp ? ramp_material(c) : palette[c % palette.size()];
+        }
+        if (!top_level) {
+            made[c].shape = painted(std::move(made[c].shape), made[c].material, fields,
+                                    made[c].has_own_material ? "copies" : given);
+        }
     }
     return made;
 }
@@ -207,7 +223,7 @@ std::vector<Copy> Loader::grid(Fields& fields) {
     return made;
 }
 
-std::vector<Copy> Loader::array(Fields& fields, bool top_level) {
+std::vector<Copy> Loader::array(Fields& fields) {
     const Json& list = fields.array("copies", 1, "copies (objects with a \"transform\")");
     if (list.size() > kMaxGridCopies) {
         fields.fail("copies", "expected at most " + std::to_string(kMaxGridCopies) +
@@ -232,7 +248,7 @@ std::vector<Copy> Loader::array(Fields& fields, bool top_level) {
             require_representable(world_from_copy, source_, entry.pointer("transform"), true);
         }
         Copy copy{place(item, world_from_copy)};
-        if (top_level && entry.has("material")) {
+        if (entry.has("material")) {
             copy.material = material_named(entry, "material", entry.string("material"));
             copy.has_own_material = true;
         }

@@ -57,12 +57,8 @@ void Fields::finish() const {
         std::string message = "unknown key " + quote_name(it.key()) + " in " + what_;
         if (it.key() == "name") {
             message += " (\"name\" belongs to the top-level objects)";
-        } else if (it.key() == "material") {
-            message +=
-                " (\"material\" of a grid, an array or their copies belongs to the "
-                "top-level objects; inside a shape, give the item its material)";
         } else if (it.key() == "materials" || it.key() == "material_ramp") {
-            message += " (\"" + it.key() + "\" belongs to top-level grids and arrays)";
+            message += " (\"" + it.key() + "\" belongs to grids and arrays)";
         }
         std::string known;
         for (const std::string& key : asked_) known += (known.empty() ? "" : ", ") + key;

@@ -52,10 +52,22 @@ ShapePointer Loader::shape(Fields& fields) {
     // Below a top-level object (whose "material" was read as the object's), a node may name a
     // material of its own; its surfaces keep it through the CSG tree (csg/painted.h).
     if (!fields.asked("material") && fields.has("material")) {
-        built = std::make_shared<Painted>(
-            std::move(built), material_named(fields, "material", fields.string("material")));
+        built =
+            painted(std::move(built), material_named(fields, "material", fields.string("material")),
+                    fields, "material");
     }
     return built;
+}
+
+ShapePointer Loader::painted(ShapePointer shape, std::uint32_t material, Fields& fields,
+                             std::string_view key) {
+    if (material > kMaxPaintedMaterial) {
+        fields.fail(key, "material " + std::to_string(material) + " of the scene is past the " +
+                             std::to_string(kMaxPaintedMaterial + 1) +
+                             " a surface inside a shape may name (a hit keeps it in 16 bits); "
+                             "the scene's first materials can be named anywhere");
+    }
+    return std::make_shared<Painted>(std::move(shape), material);
 }
 
 std::vector<ListItem> Loader::list(Fields& fields, std::string_view key, std::size_t minimum,

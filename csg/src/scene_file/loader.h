@@ -44,7 +44,7 @@ struct ListItem {
 };
 
 /// One copy made by a grid or an array node: the shape, moved into place, and at the top
-/// level the scene material it gets.
+/// level the scene material it gets (inside a shape, a material is painted on the shape).
 struct Copy {
     ShapePointer shape;
     std::uint32_t material = 0;
@@ -75,10 +75,17 @@ public:
     std::vector<ListItem> list(Fields& fields, std::string_view key, std::size_t minimum,
                                std::string_view of);
 
-    /// The copies of a grid or array node (copies.cpp), each its item moved into place. At
-    /// the top level (`top_level`) each gets its material: the node's "material", its
-    /// "materials" cycled, its "material_ramp" blended, or an array copy's own "material".
+    /// The copies of a grid or array node (copies.cpp), each its item moved into place, each
+    /// with its material: the node's "material", its "materials" cycled, its "material_ramp"
+    /// blended, or an array copy's own "material". At the top level (`top_level`) that is the
+    /// scene object's material (default: "default"); inside a shape the copy is painted with
+    /// it (csg/painted.h), and a node that names none leaves its copies unpainted.
     std::vector<Copy> copies(Fields& fields, bool top_level);
+
+    /// `shape` painted with `material` (csg/painted.h); fails at `key` when the index is past
+    /// what a hit record holds (kMaxPaintedMaterial).
+    ShapePointer painted(ShapePointer shape, std::uint32_t material, Fields& fields,
+                         std::string_view key);
 
     ShapePointer definition(const std::string& name, const std::string& pointer);
 
@@ -92,7 +99,7 @@ public:
 
 private:
     std::vector<Copy> grid(Fields& fields);
-    std::vector<Copy> array(Fields& fields, bool top_level);
+    std::vector<Copy> array(Fields& fields);
     /// Fails at `key` when `count` copies of `item` pass kMaxExpandedLeaves.
     void require_copies_fit(Fields& fields, std::string_view key, std::size_t count,
                             const Shape& item);
