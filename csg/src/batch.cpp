@@ -91,6 +91,7 @@ void check_outputs(const NearestHitOutputs<Real>& outputs, std::size_t n) {
     check_optional(outputs.uv.size(), 2 * n, "uv");
     check_optional(outputs.geometric_normal.size(), 3 * n, "geometric_normal");
     check_optional(outputs.shading_normal.size(), 3 * n, "shading_normal");
+    check_optional(outputs.material.size(), n, "material");
 }
 
 template <class Real>
@@ -101,6 +102,7 @@ void write_miss(const NearestHitOutputs<Real>& outputs, std::size_t i) {
     write2(outputs.uv, i, 0.0, 0.0);
     write3(outputs.geometric_normal, i, Vector3::Zero());
     write3(outputs.shading_normal, i, Vector3::Zero());
+    write1(outputs.material, i, kNoIndex);
 }
 
 void check_committed(const Scene& scene) {
@@ -269,6 +271,9 @@ void intersect(const Scene& scene, const RayArrays<Real>& rays,
             write2(outputs.uv, i, hit->uv.x(), hit->uv.y());
             write3(outputs.geometric_normal, i, hit->geometric_normal);
             write3(outputs.shading_normal, i, hit->shading_normal);
+            write1(outputs.material, i,
+                   hit->material != kNoIndex ? hit->material
+                                             : scene.objects()[hit->object_id].material);
         }
     });
 }
@@ -279,6 +284,9 @@ void intersect(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& ra
     check_structure(mesh);
     check_rays(rays);
     check_outputs(outputs, rays.size());
+    if (!outputs.material.empty()) {
+        throw InvalidParameter("material: a triangle structure has no materials");
+    }
     const bool wants_normal = !outputs.geometric_normal.empty() || !outputs.shading_normal.empty();
     const bool wants_ids = !outputs.object_id.empty() || !outputs.primitive_id.empty();
     const auto* bvh = dynamic_cast<const Bvh<TriangleSet<SetReal>>*>(mesh.structure);

@@ -72,9 +72,11 @@ void check_interval(double tnear, double tfar) {
     }
 }
 
-std::unordered_set<std::string> requested_outputs(const py::object& requested) {
-    const auto& known = cast_ray_outputs();
+std::unordered_set<std::string> requested_outputs(const py::object& requested,
+                                                  bool with_materials) {
+    std::vector<std::string> known = cast_ray_outputs();
     if (requested.is_none()) return {known.begin(), known.begin() + 5};
+    if (with_materials) known.emplace_back(kMaterialOutput);
     std::unordered_set<std::string> wanted;
     if (py::isinstance<py::str>(requested)) {
         throw py::value_error("outputs: expected a list of names, got the string '" +

@@ -5,6 +5,7 @@
 // with the GIL held, allocates its result arrays, releases the GIL for the batch and returns.
 
 #include <string>
+#include <type_traits>
 #include <unordered_set>
 
 #include "arrays.h"
@@ -19,8 +20,13 @@ inline const std::vector<std::string>& cast_ray_outputs() {
     return names;
 }
 
-/// Which outputs a call asked for: `requested` is None (Open3D's five) or names.
-std::unordered_set<std::string> requested_outputs(const py::object& requested);
+/// The output only a csgrt.Scene's cast_rays gives: each hit's material index.
+inline constexpr const char* kMaterialOutput = "material_ids";
+
+/// Which outputs a call asked for: `requested` is None (Open3D's five) or names, from
+/// cast_ray_outputs() and, `with_materials` (a Scene), kMaterialOutput.
+std::unordered_set<std::string> requested_outputs(const py::object& requested,
+                                                  bool with_materials);
 
 template <class Real, class Target>
 py::dict cast_rays_as(const Target& target, const FloatInput& rays, double tnear, double tfar,
@@ -32,6 +38,7 @@ py::dict cast_rays_as(const Target& target, const FloatInput& rays, double tnear
     auto uv = output<Real>(leading, {2});
     auto normal = output<Real>(leading, {3});
     auto shading = output<Real>(leading, {3});
+    auto material = output<std::uint32_t>(leading);
     NearestHitOutputs<Real> outputs;
     if (wanted.count("t_hit")) outputs.t = span_of(t);
     if (wanted.count("geometry_ids")) outputs.object_id = span_of(geometry);
@@ -39,6 +46,7 @@ py::dict cast_rays_as(const Target& target, const FloatInput& rays, double tnear
     if (wanted.count("primitive_uvs")) outputs.uv = span_of(uv);
     if (wanted.count("primitive_normals")) outputs.geometric_normal = span_of(normal);
     if (wanted.count("shading_normals")) outputs.shading_normal = span_of(shading);
+    if (wanted.count(kMaterialOutput)) outputs.material = span_of(material);
     {
         py::gil_scoped_release release;
         intersect(target, ray_arrays<Real>(rays, tnear, tfar), outputs, config);
@@ -50,6 +58,7 @@ py::dict cast_rays_as(const Target& target, const FloatInput& rays, double tnear
     if (wanted.count("primitive_uvs")) result["primitive_uvs"] = uv;
     if (wanted.count("primitive_normals")) result["primitive_normals"] = normal;
     if (wanted.count("shading_normals")) result["shading_normals"] = shading;
+    if (wanted.count(kMaterialOutput)) result[kMaterialOutput] = material;
     return result;
 }
 
@@ -58,7 +67,7 @@ py::dict cast_rays(const Target& target, const py::handle& rays_object, double t
                    double tfar, const py::object& requested, int nthreads) {
     const FloatInput rays = float_input(rays_object, "rays", 6, "(..., 6)");
     check_interval(tnear, tfar);
-    const auto wanted = requested_outputs(requested);
+    const auto wanted = requested_outputs(requested, std::is_same_v<Target, Scene>);
     const BatchConfig config = batch_config(nthreads);
     return rays.is_float32 ? cast_rays_as<float>(target, rays, tnear, tfar, wanted, config)
                            : cast_rays_as<double>(target, rays, tnear, tfar, wanted, config);

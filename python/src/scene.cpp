@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "bindings.h"
+#include "csgrt/accel/factory.h"
 #include "csgrt/mesh/mesh.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
@@ -17,26 +18,12 @@
 #include "csgrt/csg/complement.h"
 #include "csgrt/csg/compound.h"
 #include "csgrt/csg/scene_file.h"
-#include "csgrt/render/exr.h"
-#include "csgrt/render/renderer.h"
 #include "queries.h"
+#include "scene.h"
 
 namespace csgrt::python {
 
 namespace {
-
-/// A shape handed to Python: immutable and shared, so one shape may sit in several scenes.
-struct PyShape {
-    std::shared_ptr<const Shape> shape;
-};
-
-std::shared_ptr<const Shape> shape_of(const py::handle& object, const std::string& what) {
-    if (!py::isinstance<PyShape>(object)) {
-        throw py::value_error(what + ": expected a csgrt.Shape, got " +
-                              std::string(py::str(py::type::of(object).attr("__name__"))));
-    }
-    return object.cast<const PyShape&>().shape;
-}
 
 std::vector<std::shared_ptr<const Shape>> shapes_of(const py::args& args, const char* what) {
     std::vector<std::shared_ptr<const Shape>> shapes;
@@ -69,16 +56,6 @@ PyShape shape_from_node(const std::string& type, const py::kwargs& params) {
                               " objects; wrap them in csgrt.compound(...)");
     }
     return PyShape{scene.objects()[0].shape};
-}
-
-template <class T>
-Eigen::Vector3d vector3(const T& value, const char* what) {
-    const py::array_t<double, py::array::c_style | py::array::forcecast> array =
-        py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
-    if (!array || array.size() != 3) {
-        throw py::value_error(std::string(what) + ": expected 3 numbers");
-    }
-    return {array.at(0), array.at(1), array.at(2)};
 }
 
 TriangleMeshData mesh_data(const py::handle& vertices_object, const py::handle& triangles_object) {
@@ -114,164 +91,6 @@ TriangleMeshData mesh_data(const py::handle& vertices_object, const py::handle& 
         data.triangles.push_back(triangle);
     }
     return data;
-}
-
-/// A scene built from Python: objects, materials, lights and camera are added to `building`;
-/// commit() commits a copy and publishes it, and every query reads the last published one. So
-/// adding from one thread while others query is safe, and queries never see a half-built
-/// scene.
-class PyScene {
-public:
-    PyScene() = default;
-    explicit PyScene(Scene scene) : building_(std::move(scene)) {}
-
-    std::uint32_t add_object(const py::handle& shape, const py::object& material,
-                             const std::string& name) {
-        std::uint32_t index = 0;
-        if (py::isinstance<py::str>(material)) {
-            const std::string wanted = material.cast<std::string>();
-            const auto& materials = building_.materials();
-            auto it = std::find_if(materials.begin(), materials.end(),
-                                   [&](const Material& m) { return m.name == wanted; });
-            if (it == materials.end()) {
-                throw py::value_error("material: no material named '" + wanted + "'");
-            }
-            index = static_cast<std::uint32_t>(it - materials.begin());
-        } else {
-            index = material.cast<std::uint32_t>();
-        }
-        std::lock_guard<std::mutex> lock(building_mutex_);
-        return building_.add_object(shape_of(shape, "shape"), index, name);
-    }
-    std::uint32_t add_material(const std::string& name, const py::object& albedo) {
-        std::lock_guard<std::mutex> lock(building_mutex_);
-        return building_.add_material(Material{name, vector3(albedo, "albedo")});
-    }
-    void add_point_light(const py::object& position, const py::object& intensity) {
-        PointLight light;
-        light.position = vector3(position, "position");
-        light.intensity = py::isinstance<py::float_>(intensity) || py::isinstance<py::int_>(intensity)
-                              ? Vector3::Constant(intensity.cast<double>())
-                              : vector3(intensity, "intensity");
-        std::lock_guard<std::mutex> lock(building_mutex_);
-        building_.add_light(light);
-    }
-    void add_directional_light(const py::object& direction, const py::object& radiance) {
-        DirectionalLight light;
-        light.direction = vector3(direction, "direction");
-        light.radiance = py::isinstance<py::float_>(radiance) || py::isinstance<py::int_>(radiance)
-                             ? Vector3::Constant(radiance.cast<double>())
-                             : vector3(radiance, "radiance");
-        std::lock_guard<std::mutex> lock(building_mutex_);
-        building_.add_light(light);
-    }
-    void set_camera(const py::object& position, const py::object& look_at, const py::object& up,
-                    double fov, const std::string& projection, double height) {
-        Camera camera;
-        camera.position = vector3(position, "position");
-        camera.look_at = vector3(look_at, "look_at");
-        camera.up = vector3(up, "up");
-        camera.vertical_fov_degrees = fov;
-        camera.orthographic_height = height;
-        if (projection == "orthographic") {
-            camera.projection = Camera::Projection::Orthographic;
-        } else if (projection != "pinhole") {
-            throw py::value_error("projection: expected 'pinhole' or 'orthographic', got '" +
-                                  projection + "'");
-        }
-        camera.validate();
-        std::lock_guard<std::mutex> lock(building_mutex_);
-        building_.set_camera(camera);
-    }
-
-    void commit(const std::string& accelerator) {
-        py::gil_scoped_release release;
-        std::lock_guard<std::mutex> lock(building_mutex_);
-        auto next = std::make_shared<Scene>(building_);
-        SceneConfig config;
-        config.accelerator = accelerator;
-        next->commit(config);
-        std::lock_guard<std::mutex> publish(pointer_mutex_);
-        committed_ = std::move(next);
-    }
-
-    /// The last committed scene; ValueError before the first commit.
-    std::shared_ptr<const Scene> committed() const {
-        std::lock_guard<std::mutex> lock(pointer_mutex_);
-        if (!committed_) {
-            throw py::value_error("scene: not committed; call commit() after adding objects");
-        }
-        return committed_;
-    }
-    std::size_t object_count() const {
-        std::lock_guard<std::mutex> lock(building_mutex_);
-        return building_.objects().size();
-    }
-
-private:
-    mutable std::mutex building_mutex_;
-    Scene building_;
-    mutable std::mutex pointer_mutex_;
-    std::shared_ptr<const Scene> committed_;
-};
-
-py::dict render_scene(const PyScene& self, int width, int height, int spp, int nthreads,
-                      std::uint64_t seed, const py::object& exr_path) {
-    const auto scene = self.committed();
-    RenderSettings settings;
-    settings.width = width;
-    settings.height = height;
-    settings.samples_per_pixel = spp;
-    settings.threads = nthreads;
-    settings.seed = seed;
-    validate(settings);
-    RenderResult result;
-    {
-        py::gil_scoped_release release;
-        result = render(*scene, settings);
-    }
-    const auto h = static_cast<py::ssize_t>(height), w = static_cast<py::ssize_t>(width);
-    py::array_t<float> color(std::vector<py::ssize_t>{h, w, 4});
-    py::array_t<float> depth(std::vector<py::ssize_t>{h, w});
-    py::array_t<float> normal(std::vector<py::ssize_t>{h, w, 3});
-    py::array_t<std::uint32_t> object_id(std::vector<py::ssize_t>{h, w});
-    py::array_t<float> cost(std::vector<py::ssize_t>{h, w});
-    float* c = color.mutable_data();
-    float* d = depth.mutable_data();
-    float* n = normal.mutable_data();
-    std::uint32_t* id = object_id.mutable_data();
-    float* k = cost.mutable_data();
-    const auto& pixels = result.image.pixels();
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
-        const Pixel& p = pixels[i];
-        c[4 * i] = p.red, c[4 * i + 1] = p.green, c[4 * i + 2] = p.blue, c[4 * i + 3] = p.alpha;
-        d[i] = p.depth;
-        n[3 * i] = p.normal_x, n[3 * i + 1] = p.normal_y, n[3 * i + 2] = p.normal_z;
-        id[i] = p.object_id;
-        k[i] = p.cost;
-    }
-    if (!exr_path.is_none()) {
-        ExrMetadata metadata;
-        metadata.camera = scene->camera();
-        metadata.accelerator = std::string(scene->accelerator_name());
-        metadata.accelerator_build_milliseconds = scene->accelerator_stats().build_milliseconds;
-        metadata.samples_per_pixel = spp;
-        const std::filesystem::path path = py::str(exr_path).cast<std::string>();
-        py::gil_scoped_release release;
-        write_render_files(path, result.image, metadata);
-    }
-    py::dict out;
-    out["color"] = color;
-    out["depth"] = depth;
-    out["normal"] = normal;
-    out["object_id"] = object_id;
-    out["cost"] = cost;
-    py::dict stats;
-    stats["primary_rays"] = result.stats.primary_rays;
-    stats["shadow_rays"] = result.stats.shadow_rays;
-    stats["seconds"] = result.stats.seconds;
-    out["stats"] = stats;
-    return out;
 }
 
 }  // namespace
@@ -356,6 +175,32 @@ values it rejects, raise ValueError naming the parameter.
         "Everything outside a solid (the scene file's \"not\"), itself a solid: "
         "intersection(a, complement(b)) is difference(a, b).");
     m.def(
+        "accelerator_names",
+        [] {
+            std::vector<std::string> names;
+            for (const std::string_view name : accelerator_names()) names.emplace_back(name);
+            return names;
+        },
+        "The structure names commit(), compound(), mesh() and cost_layers() take, in the "
+        "order `csgrt render --cost-all` draws them.");
+    m.def(
+        "painted",
+        [](const py::object& shape, std::uint32_t material) {
+            if (material > kMaxPaintedMaterial) {
+                throw py::value_error("material: expected an index up to " +
+                                      std::to_string(kMaxPaintedMaterial) + ", got " +
+                                      std::to_string(material));
+            }
+            return PyShape{std::make_shared<Painted>(shape_of(shape, "shape"), material)};
+        },
+        "shape"_a, "material"_a, R"doc(
+The shape with a material of its own (the scene file's ``material`` on a node below an object):
+its hits carry ``material`` (an index from Scene.add_material) through booleans, instances and
+compounds, the innermost painted shape winning, and surfaces under no painted shape take their
+object's. A cut surface belongs to the operand that cut it, so difference(painted(box, 1),
+painted(ball, 2)) shows material 2 inside the bite. Scene.commit() checks the index.
+)doc");
+    m.def(
         "compound",
         [](const py::list& children, const std::string& accelerator) {
             std::vector<std::shared_ptr<const Shape>> shapes;
@@ -393,18 +238,21 @@ values it rejects, raise ValueError naming the parameter.
         "so t is the same in both spaces.");
     m.def(
         "mesh",
-        [](const py::handle& vertices, const py::handle& triangles, bool double_precision) {
+        [](const py::handle& vertices, const py::handle& triangles, bool double_precision,
+           const std::string& accelerator) {
             MeshConfig config;
             config.double_precision = double_precision;
+            if (!accelerator.empty()) config.accelerator = accelerator;
             auto data = mesh_data(vertices, triangles);
             py::gil_scoped_release release;
             return PyShape{std::make_shared<Mesh>(std::move(data), config)};
         },
-        "vertices"_a, "triangles"_a, "double_precision"_a = false,
+        "vertices"_a, "triangles"_a, "double_precision"_a = false, "accelerator"_a = "",
         "A triangle mesh shape from arrays: vertices (N, 3), triangles (M, 3) integer indices. "
         "Validated as mesh files are (degenerate triangles dropped, closed shells oriented "
         "outward, docs/meshes.md): a closed mesh is a solid. Triangles in float32 unless "
-        "double_precision.");
+        "double_precision. accelerator: the structure over the triangles ('bvh', 'grid', ...; "
+        "empty: the mesh default).");
     m.def(
         "read_mesh",
         [](const std::string& path) {
@@ -538,15 +386,7 @@ shape. Objects added after commit() are seen by queries after the next commit().
         ("1.0 where a point is inside a solid object (CSG trees, analytic solids, closed "
          "meshes; each solid's own exact membership test), 0.0 elsewhere (float32).\n"
          "nsamples: must be 1.\n" + std::string(kPointsDoc) + "\n" + kThreadsDoc).c_str());
-    scene.def("render", &render_scene, "width"_a, "height"_a, "spp"_a = 1, "nthreads"_a = 0,
-              "seed"_a = 0, "exr_path"_a = py::none(), R"doc(
-Renders the committed scene through its camera (docs/rendering.md) and returns a dict of
-arrays, rows from the top: ``color`` (height, width, 4) float32 linear RGBA, premultiplied;
-``depth`` (height, width) float32, inf for background; ``normal`` (height, width, 3);
-``object_id`` (height, width) uint32, 2**32 - 1 for background; ``cost`` (height, width); and
-``stats`` (primary_rays, shadow_rays, seconds). With exr_path, also writes the multi-channel
-EXR and its PNG previews as `csgrt render` does. The image does not depend on nthreads.
-)doc");
+    bind_rendering(scene);
 
     m.def(
         "load_scene",

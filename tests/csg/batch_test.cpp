@@ -16,6 +16,7 @@
 #include "csgrt/core/plane.h"
 #include "csgrt/core/sphere.h"
 #include "csgrt/csg/boolean.h"
+#include "csgrt/csg/painted.h"
 #include "csgrt/mesh/mesh.h"
 #include "support/meshes.h"
 #include "support/random.h"
@@ -30,9 +31,15 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // difference, an instanced box, a closed mesh, and the unbounded ground.
 Scene mixed_scene() {
     Scene scene;
-    scene.add_object(std::make_shared<Sphere>(Point3(-2, 1, 0), 1.0));
+    // Materials 1 and 2 for two objects, 3 painted on the subtracted ball (the bite's surface).
+    for (const char* name : {"a", "b", "c"}) {
+        scene.add_material(Material{name, Vector3(0.5, 0.5, 0.5)});
+    }
+    scene.add_object(std::make_shared<Sphere>(Point3(-2, 1, 0), 1.0), 1);
     scene.add_object(make_difference(std::make_shared<Box>(Point3(1, 0, -1), Point3(3, 2, 1)),
-                                     {std::make_shared<Sphere>(Point3(2, 2, 0), 0.8)}));
+                                     {std::make_shared<Painted>(
+                                         std::make_shared<Sphere>(Point3(2, 2, 0), 0.8), 3)}),
+                     2);
     Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.7, Vector3(0, 1, 0)).toRotationMatrix();
     scene.add_object(std::make_shared<Instance>(
         std::make_shared<Box>(Point3(-0.5, 0, -0.5), Point3(0.5, 1, 0.5)),
@@ -91,10 +98,14 @@ RayBuffer<Real> scene_rays(int count) {
 template <class Real>
 struct NearestHits {
     std::vector<Real> t, uv, geometric, shading;
-    std::vector<std::uint32_t> object, primitive;
+    std::vector<std::uint32_t> object, primitive, material;
     explicit NearestHits(std::size_t n)
-        : t(n), uv(2 * n), geometric(3 * n), shading(3 * n), object(n), primitive(n) {}
-    NearestHitOutputs<Real> outputs() { return {t, object, primitive, uv, geometric, shading}; }
+        : t(n), uv(2 * n), geometric(3 * n), shading(3 * n), object(n), primitive(n), material(n) {}
+    NearestHitOutputs<Real> outputs() { return {t, object, primitive, uv, geometric, shading, {}}; }
+    /// With the material, which only a scene has.
+    NearestHitOutputs<Real> scene_outputs() {
+        return {t, object, primitive, uv, geometric, shading, material};
+    }
     bool operator==(const NearestHits&) const = default;
 };
 
@@ -122,20 +133,26 @@ TYPED_TEST(BatchTest, SceneNearestHitsAreTheSingleRayAnswersForEveryThreadCount)
     const RayBuffer<Real> buffer = scene_rays<Real>(3000);
     const std::size_t n = buffer.size();
     NearestHits<Real> one(n);
-    intersect(scene, buffer.arrays(), one.outputs(), BatchConfig{1, 64});
+    intersect(scene, buffer.arrays(), one.scene_outputs(), BatchConfig{1, 64});
 
     QueryScratch scratch;
-    std::size_t hits = 0;
+    std::size_t hits = 0, painted_hits = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const auto hit = scene.intersect(buffer.arrays().ray(i), scratch);
         if (!hit) {
             ASSERT_EQ(one.t[i], std::numeric_limits<Real>::infinity()) << i;
             ASSERT_EQ(one.object[i], kNoIndex);
             ASSERT_EQ(one.primitive[i], kNoIndex);
+            ASSERT_EQ(one.material[i], kNoIndex);
             ASSERT_EQ(one.geometric[3 * i], Real(0));
             continue;
         }
         ++hits;
+        // The surface's material: the painted ball's inside the bite, else the object's.
+        const std::uint32_t material =
+            hit->material != kNoIndex ? hit->material : scene.objects()[hit->object_id].material;
+        ASSERT_EQ(one.material[i], material) << i;
+        painted_hits += hit->material == 3u ? 1 : 0;
         ASSERT_EQ(one.t[i], static_cast<Real>(hit->t)) << i;
         ASSERT_EQ(one.object[i], hit->object_id) << i;
         ASSERT_EQ(one.primitive[i], hit->primitive_id) << i;
@@ -145,12 +162,13 @@ TYPED_TEST(BatchTest, SceneNearestHitsAreTheSingleRayAnswersForEveryThreadCount)
             ASSERT_EQ(one.shading[3 * i + k], static_cast<Real>(hit->shading_normal[k]));
         }
     }
-    EXPECT_GT(hits, n / 3);  // the rays do reach the objects
+    EXPECT_GT(hits, n / 3);       // the rays do reach the objects
+    EXPECT_GT(painted_hits, 0u);  // and the bite
     for (std::size_t k = n - 4; k < n; ++k) EXPECT_EQ(one.object[k], kNoIndex);  // invalid
 
     for (int threads : {2, 3, 0}) {
         NearestHits<Real> many(n);
-        intersect(scene, buffer.arrays(), many.outputs(), BatchConfig{threads, 7});
+        intersect(scene, buffer.arrays(), many.scene_outputs(), BatchConfig{threads, 7});
         EXPECT_TRUE(many == one) << threads << " threads";
     }
 }
@@ -270,6 +288,9 @@ TYPED_TEST(BatchTest, TriangleQueriesAgainstTheStructureBruteForceAndMembership)
     std::vector<Real> t_only(n);
     intersect(meshes.structure(), buffer.arrays(), only_t(t_only), threads(1));
     EXPECT_EQ(t_only, all.t);
+    // Triangles have no materials: asking for them is an error, not a column of kNoIndex.
+    EXPECT_THROW(intersect(meshes.structure(), buffer.arrays(), all.scene_outputs(), threads(1)),
+                 InvalidParameter);
 
     QueryScratch scratch;
     std::vector<HitRecord> brute_hits;

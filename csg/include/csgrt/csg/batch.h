@@ -77,6 +77,10 @@ struct NearestHitOutputs {
     std::span<Real> uv;
     std::span<Real> geometric_normal;
     std::span<Real> shading_normal;
+    /// A scene's only: the material index of the surface hit, the innermost painted
+    /// operand's (csg/painted.h) or else its object's, as the renderer shades it; kNoIndex on
+    /// a miss. A triangle structure has no materials: asking it throws InvalidParameter.
+    std::span<std::uint32_t> material;
 };
 
 /// One crossing of a ray with a surface, as the crossing list reports it.
