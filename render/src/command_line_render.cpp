@@ -189,14 +189,23 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
 
     // --cost-all: the scene rebuilt with each registered structure at every level, its centre
     // rays counted (docs/rendering.md).
+    // A line per structure on stderr as it goes: brute force on a big mesh takes a while.
     std::vector<CostLayer> layers;
     if (options.cost_all) {
         stage_start = Clock::now();
         RenderSettings cost_settings = settings;
         cost_settings.progress = nullptr;
         const std::span<const std::string_view> names = accelerator_names();
-        layers = cost_layers(scene, cost_settings,
-                             std::vector<std::string_view>(names.begin(), names.end()));
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            streams.err << "cost of every structure: " << names[i] << " (" << i + 1 << " of "
+                        << names.size() << ") ..." << std::flush;
+            layers.push_back(cost_layer(scene, cost_settings, names[i]));
+            char done[96];
+            std::snprintf(done, sizeof(done), " built in %.3f ms, traced in %.3f s\n",
+                          layers.back().build_milliseconds,
+                          layers.back().trace_milliseconds / 1000.0);
+            streams.err << done << std::flush;
+        }
         stage_seconds.emplace_back("cost of every structure", seconds_since(stage_start));
     }
 
@@ -239,6 +248,7 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
             for (const CostLayer& layer : layers) {
                 summary["cost_layers"].push_back({{"structure", layer.structure},
                                                   {"build_milliseconds", layer.build_milliseconds},
+                                                  {"trace_milliseconds", layer.trace_milliseconds},
                                                   {"total", cost_sum(layer)}});
             }
         }

@@ -1,5 +1,6 @@
 #include "csgrt/render/cost_layers.h"
 
+#include <chrono>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -167,15 +168,23 @@ std::uint64_t cost_sum(const CostLayer& layer) {
     return sum;
 }
 
+CostLayer cost_layer(const Scene& scene, const RenderSettings& settings,
+                     std::string_view structure) {
+    const Scene rebuilt = with_every_structure(scene, structure);
+    const auto start = std::chrono::steady_clock::now();
+    CostLayer layer = render_cost(rebuilt, settings);
+    layer.trace_milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    layer.structure = std::string(structure);
+    layer.build_milliseconds = structure_build_milliseconds(rebuilt);
+    return layer;
+}
+
 std::vector<CostLayer> cost_layers(const Scene& scene, const RenderSettings& settings,
                                    const std::vector<std::string_view>& structures) {
     std::vector<CostLayer> layers;
     for (const std::string_view structure : structures) {
-        const Scene rebuilt = with_every_structure(scene, structure);
-        CostLayer layer = render_cost(rebuilt, settings);
-        layer.structure = std::string(structure);
-        layer.build_milliseconds = structure_build_milliseconds(rebuilt);
-        layers.push_back(std::move(layer));
+        layers.push_back(cost_layer(scene, settings, structure));
     }
     return layers;
 }

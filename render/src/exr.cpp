@@ -209,6 +209,8 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
         }
         header.insert("cost." + layer.structure + ".buildMilliseconds",
                       Imf::DoubleAttribute(layer.build_milliseconds));
+        header.insert("cost." + layer.structure + ".traceMilliseconds",
+                      Imf::DoubleAttribute(layer.trace_milliseconds));
     }
     Imf::addIDManifest(headers[kIdPart], Imf::CompressedIDManifest(id_manifest(metadata)));
 
@@ -283,6 +285,10 @@ void read_cost_layers(Imf::MultiPartInputFile& file, ExrFile& result) {
         if (const auto* built = header.findTypedAttribute<Imf::DoubleAttribute>(
                 "cost." + layer.structure + ".buildMilliseconds")) {
             layer.build_milliseconds = built->value();
+        }
+        if (const auto* traced = header.findTypedAttribute<Imf::DoubleAttribute>(
+                "cost." + layer.structure + ".traceMilliseconds")) {
+            layer.trace_milliseconds = traced->value();
         }
         result.cost_layers.push_back(std::move(layer));
     }

@@ -60,8 +60,9 @@ void print_statistics(std::ostream& out, const Scene& scene, const RenderStats& 
     if (!layers.empty()) {
         out << "Every structure at every level (--cost-all), centre rays\n";
         for (const CostLayer& layer : layers) {
-            char note[64];
-            std::snprintf(note, sizeof(note), "built in %.3f ms", layer.build_milliseconds);
+            char note[96];
+            std::snprintf(note, sizeof(note), "built in %.3f ms, traced in %.3f s",
+                          layer.build_milliseconds, layer.trace_milliseconds / 1000.0);
             row(layer.structure.c_str(), cost_sum(layer), note);
         }
     }

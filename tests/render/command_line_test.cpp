@@ -236,6 +236,17 @@ TEST_F(CommandLine, CostAllWritesALayerPerStructureAndTheirContactSheet) {
     EXPECT_EQ(structures, expected);  // the file lists channels alphabetically
     EXPECT_NE(result.out.find("Every structure at every level"), std::string::npos);
     EXPECT_NE(result.out.find("cost of every structure"), std::string::npos);
+    // Progress on stderr, a line per structure in the registry's order, each with its times;
+    // the traces' times are in the file too.
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < accelerator_names().size(); ++i) {
+        const std::string line = "cost of every structure: " + std::string(accelerator_names()[i]) +
+                                 " (" + std::to_string(i + 1) + " of " +
+                                 std::to_string(accelerator_names().size()) + ") ... built in ";
+        at = result.err.find(line, at);
+        ASSERT_NE(at, std::string::npos) << line << " in:\n" << result.err;
+    }
+    for (const CostLayer& layer : file.cost_layers) EXPECT_GT(layer.trace_milliseconds, 0.0);
 }
 
 TEST_F(CommandLine, EveryDocumentedStructureRendersTheSameImage) {

@@ -271,6 +271,7 @@ TEST(CostLayers, EachLayerIsTheCostOfTheSceneBuiltWithItsStructure) {
         EXPECT_EQ(layer.width, 8);
         ASSERT_EQ(layer.total.size(), 48u);
         EXPECT_GE(layer.build_milliseconds, 0.0);
+        EXPECT_GT(layer.trace_milliseconds, 0.0);  // 48 rays through 512 triangles each
     }
     // Brute force at both levels: the scene's test of the mesh and its 512 triangles, everywhere.
     for (std::size_t i = 0; i < 48; ++i) {
@@ -297,6 +298,7 @@ TEST(CostLayers, EachLayerIsTheCostOfTheSceneBuiltWithItsStructure) {
     for (std::size_t k = 0; k < 2; ++k) {
         EXPECT_EQ(file.cost_layers[k].structure, layers[k].structure);
         EXPECT_EQ(file.cost_layers[k].build_milliseconds, layers[k].build_milliseconds);
+        EXPECT_EQ(file.cost_layers[k].trace_milliseconds, layers[k].trace_milliseconds);
         EXPECT_EQ(file.cost_layers[k].total, layers[k].total);
         EXPECT_EQ(file.cost_layers[k].solves, layers[k].solves);
     }

@@ -28,9 +28,14 @@ double structure_build_milliseconds(const Scene& scene);
 /// The sum of a layer's total cost over its pixels (exact: the pixels hold integer counts).
 std::uint64_t cost_sum(const CostLayer& layer);
 
-/// One cost layer per structure name in `structures` (accelerator_names() for --cost-all):
-/// `scene` rebuilt with with_every_structure, its build time, and render_cost's channels at
-/// `settings`' size.
+/// The cost layer of one structure: `scene` rebuilt with with_every_structure(scene,
+/// structure), its build time, render_cost's channels at `settings`' size (centre rays only:
+/// no shading, no shadow or secondary ray), and the wall time of that trace.
+CostLayer cost_layer(const Scene& scene, const RenderSettings& settings,
+                     std::string_view structure);
+
+/// One cost layer per structure name in `structures` (accelerator_names() for --cost-all), in
+/// that order.
 std::vector<CostLayer> cost_layers(const Scene& scene, const RenderSettings& settings,
                                    const std::vector<std::string_view>& structures);
 

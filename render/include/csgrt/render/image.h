@@ -71,8 +71,13 @@ struct CostLayer {
     /// The factory name of the structure every level of the scene was built with.
     std::string structure;
     /// The build times of every structure in that scene (the top level's, each compound's and
-    /// each mesh's), summed.
+    /// each mesh's), summed: the time in their build(). Ray classification splits its cells
+    /// as rays reach them, so for it this is the clusters and the six root cells only; the
+    /// splitting is inside trace_milliseconds.
     double build_milliseconds = 0.0;
+    /// The wall time of tracing and counting the layer's centre rays (with every lazy build
+    /// the rays caused).
+    double trace_milliseconds = 0.0;
     int width = 0;
     int height = 0;
     std::vector<float> nodes;
