@@ -50,8 +50,9 @@ std::vector<ExrObject> exr_objects(const Scene& scene);
 /// - "id": id as uint (kNoIndex = 4294967295 for background), with the idManifest.
 /// ZIP compressed, no timestamps. Readers that know one part only (Imf::InputFile) see "rgba".
 /// Each of `cost_layers` (csgrt render --cost-all) adds the float channels
-/// cost.<structure>.nodes, .primitives, .solves and .total to "rgba", and the header attribute
-/// cost.<structure>.buildMilliseconds (a timing: such files differ from run to run).
+/// cost.<structure>.nodes, .primitives, .solves and .total to "rgba", and the header attributes
+/// cost.<structure>.buildMilliseconds and .traceMilliseconds (timings: such files differ from
+/// run to run).
 /// Written to a temporary file in the same directory and renamed over `path`, so `path` is
 /// either the old file or the complete new one. Throws std::runtime_error naming the path when
 /// it cannot be written.
