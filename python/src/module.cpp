@@ -16,9 +16,11 @@ csgrt: exact ray queries on triangle meshes, analytic shapes and CSG solids, man
   test_occlusions, count_intersections, list_intersections, compute_occupancy,
   compute_closest_points, compute_distance, compute_signed_distance).
 - Scene, load_scene: any csgrt scene (CSG, analytic shapes, instances, meshes) with the same
-  ray queries, point membership and render().
+  ray queries (and each hit's material), point membership, render() and the cost of every
+  structure (cost_layers).
 - Shapes: shape() and one function per scene-file type (sphere, box, torus, ...), union,
-  intersection, difference, compound, instance, mesh, load_mesh.
+  intersection, difference, complement, painted (an operand's own material), compound,
+  instance, mesh, load_mesh.
 
 Inputs are NumPy arrays, float32 or float64 used in place when C-contiguous; every query
 releases the GIL. See docs/python.md.
