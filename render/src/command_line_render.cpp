@@ -108,11 +108,13 @@ public:
         err_ << line << std::flush;
     }
 
-    /// Clears the bar's line, if one was drawn.
-    void finish() {
+    /// Clears the bar's line, if one was drawn; returns whether one was.
+    bool finish() {
         std::lock_guard lock(mutex_);
+        const bool drawn = drawn_;
         if (drawn_) err_ << '\r' << std::string(kWidth + 40, ' ') << '\r' << std::flush;
         drawn_ = false;
+        return drawn;
     }
 
 private:
@@ -194,17 +196,26 @@ void render_command(const RenderOptions& options, CommandLineStreams streams) {
     if (options.cost_all) {
         stage_start = Clock::now();
         RenderSettings cost_settings = settings;
-        cost_settings.progress = nullptr;
         const std::span<const std::string_view> names = accelerator_names();
         for (std::size_t i = 0; i < names.size(); ++i) {
-            streams.err << "cost of every structure: " << names[i] << " (" << i + 1 << " of "
-                        << names.size() << ") ..." << std::flush;
+            const std::string line = "cost of every structure: " + std::string(names[i]) + " (" +
+                                     std::to_string(i + 1) + " of " + std::to_string(names.size()) +
+                                     ") ...";
+            streams.err << line << std::flush;
+            // On a terminal a long trace also draws the bar, over the line, which is then
+            // written again.
+            ProgressBar structure_bar(streams.err, streams.err_is_terminal,
+                                      streams.progress_delay_seconds);
+            cost_settings.progress = [&structure_bar](double fraction) {
+                structure_bar.update(fraction);
+            };
             layers.push_back(cost_layer(scene, cost_settings, names[i]));
+            const bool redraw = structure_bar.finish();
             char done[96];
             std::snprintf(done, sizeof(done), " built in %.3f ms, traced in %.3f s\n",
                           layers.back().build_milliseconds,
                           layers.back().trace_milliseconds / 1000.0);
-            streams.err << done << std::flush;
+            streams.err << (redraw ? line : std::string()) << done << std::flush;
         }
         stage_seconds.emplace_back("cost of every structure", seconds_since(stage_start));
     }

@@ -404,6 +404,27 @@ TEST_F(CommandLine, TheProgressBarAppearsOnATerminalOnlyAfterTheDelay) {
     EXPECT_NE(err.find("%"), std::string::npos) << err;
     EXPECT_EQ(err.back(), '\r');
     EXPECT_EQ(err.find('\n'), std::string::npos);
+
+    // --cost-all on a terminal with no delay: each structure's bar is drawn over its line,
+    // cleared, and the line written again whole with its times.
+    const std::vector<std::string> arguments = {
+        "csgrt", "render", scene_, "-o", output_, "--width", "16", "--height", "12", "--cost-all"};
+    std::vector<const char*> argv;
+    for (const std::string& argument : arguments) argv.push_back(argument.c_str());
+    std::ostringstream out, cost_err;
+    ASSERT_EQ(run_csgrt(static_cast<int>(argv.size()), argv.data(),
+                        CommandLineStreams{out, cost_err, true, 0.0}),
+              0);
+    const std::string text = cost_err.str();
+    const std::string last = "cost of every structure: " + std::string(accelerator_names().back()) +
+                             " (" + std::to_string(accelerator_names().size()) + " of " +
+                             std::to_string(accelerator_names().size()) + ") ...";
+    const std::size_t at = text.rfind(last);
+    ASSERT_NE(at, std::string::npos) << text;
+    EXPECT_NE(text.find("%", 0), std::string::npos) << text;  // bars were drawn
+    EXPECT_NE(text.find(" built in ", at), std::string::npos) << text;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'),
+              static_cast<std::ptrdiff_t>(accelerator_names().size()));
 }
 
 TEST_F(CommandLine, ValidatePrintsNothingForAGoodScene) {
