@@ -4,9 +4,16 @@
 // test's own float operations, four or eight lanes at a time, and the ray-parallel test of a
 // packet. Private to accel/src/bvh*.
 
+#include <type_traits>
+
 #include "bvh_ray.h"
 
 namespace csgrt::detail {
+
+/// Whether a Bvh over Set may keep its leaves' triangles in blocks (BvhConfig::
+/// triangle_blocks): TriangleSet<float> only.
+template <class Set>
+inline constexpr bool kBlockLeaves = std::is_same_v<Set, TriangleSet<float>>;
 
 /// Four triangles of a block sheared into the frame of the ray, lane by lane, with their edge
 /// functions.

@@ -1,0 +1,398 @@
+// The BVH's packet queries (Bvh::intersect_packets, occluded_packets): up to kPacketRays rays
+// through the wide tree together, with the single-ray leaf tests of bvh_traversal.h.
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <new>
+#include <span>
+#include <type_traits>
+
+#include "bvh_traversal.h"
+#include "csgrt/accel/bvh.h"
+#include "csgrt/accel/shape_set.h"
+#include "csgrt/accel/triangle_set.h"
+#include "csgrt/core/error.h"
+
+namespace csgrt {
+
+namespace detail {
+
+/// The packet queries, for each layout and instruction set.
+template <class Set>
+struct BvhTraversal<Set>::Packets {
+#if CSGRT_BVH_AVX2
+    template <class NodeTest>
+    static constexpr bool kAvx2Test = std::is_same_v<NodeTest, Avx2NodeTest>;
+#else
+    template <class NodeTest>
+    static constexpr bool kAvx2Test = false;
+#endif
+
+    /// The rays of a packet: each one's box ray and float upper bound, and, made when first
+    /// needed, its node test (the ray-by-ray walk only) and its leaf ray (at its first leaf:
+    /// most camera rays reach none).
+    template <class NodeTest>
+    struct PacketLanes {
+        using LeafRayType = LeafRayOf<kAvx2Test<NodeTest>>;
+        struct Lane {
+            BoxRay box;
+            float t_max;
+        };
+        static_assert(std::is_trivially_destructible_v<Lane> &&
+                      std::is_trivially_destructible_v<NodeTest> &&
+                      std::is_trivially_destructible_v<LeafRayType>);
+        alignas(Lane) unsigned char lane_storage[sizeof(Lane) * Tree::kPacketRays];
+        alignas(NodeTest) unsigned char test_storage[sizeof(NodeTest) * Tree::kPacketRays];
+        alignas(LeafRayType) unsigned char leaf_storage[sizeof(LeafRayType) * Tree::kPacketRays];
+        std::uint32_t leaf_made = 0;
+
+        Lane& operator[](int r) { return reinterpret_cast<Lane*>(lane_storage)[r]; }
+        const Lane& operator[](int r) const {
+            return reinterpret_cast<const Lane*>(lane_storage)[r];
+        }
+        void make(int r, const Ray& ray) {
+            new (&(*this)[r]) Lane{BoxRay(ray), round_up(ray.t_max)};
+        }
+        NodeTest& test(int r) { return reinterpret_cast<NodeTest*>(test_storage)[r]; }
+        void make_test(int r) { new (&test(r)) NodeTest((*this)[r].box); }
+        const LeafRayType& leaf(int r, const Set& set, const Ray& ray, QueryScratch& scratch) {
+            LeafRayType* leaves = reinterpret_cast<LeafRayType*>(leaf_storage);
+            if ((leaf_made >> r & 1u) == 0) {
+                new (&leaves[r]) LeafRayType(set, ray, scratch);
+                leaf_made |= 1u << r;
+            }
+            return leaves[r];
+        }
+    };
+    struct PacketEntry {
+        std::uint32_t first;
+        std::uint32_t count;
+        /// The rays that entered the child (bit r for ray r) and the least of their entries.
+        std::uint32_t rays;
+        float t_enter;
+    };
+
+    /// The leaf (first, count) for each of a packet's rays in `rays` (bits), each with its own
+    /// leaf test and t_max: nearest hits into best and found, or occlusion into found, a ray
+    /// that is occluded leaving `open`.
+    template <bool kAny, class Lanes>
+    static void leaf_for_rays(const Tree& bvh, std::span<const Ray> packet, Lanes& lanes,
+                              std::uint32_t rays, std::uint32_t first, std::uint32_t count,
+                              HitRecord* best, bool* found, std::uint32_t& open,
+                              QueryScratch& scratch) {
+        TraversalCounters unused;
+        for (std::uint32_t m = rays; m != 0; m &= m - 1) {
+            const int r = std::countr_zero(m);
+            const auto& leaf_ray = lanes.leaf(r, *bvh.set_, packet[r], scratch);
+            if constexpr (kAny) {
+                if (occluded_in_leaf<false>(bvh, leaf_ray, first, count, unused)) {
+                    found[r] = true;
+                    open &= ~(1u << r);
+                }
+            } else {
+                found[r] |= nearest_in_leaf<false>(bvh, leaf_ray, first, count, best[r],
+                                                   lanes[r].t_max, unused);
+            }
+        }
+    }
+
+    /// Traverses the wide tree once for up to kPacketRays rays: every node is tested against
+    /// each ray that entered it, exactly as the single-ray traversal tests it (same node test,
+    /// same t_max), and a ray enters a child only when its own test says so; a leaf is tested
+    /// for each ray that entered it. A ray thus tests every primitive its single-ray traversal
+    /// may need (the culling is the single-ray culling, only its order differs), and the tie
+    /// rule of the set makes the nearest hit independent of the order: the answers are the
+    /// single-ray answers bit for bit. Children are visited nearest first by the least entry
+    /// of the rays that entered them. kAny: occlusion (occluded[r]); else nearest hits (best[r],
+    /// found[r]). Invalid rays are left out.
+    template <bool kAny, class NodeTest, int kWidth>
+    static void traverse_packet(const Tree& bvh, const WideBvhNodes<kWidth>& nodes,
+                                std::span<const Ray> rays, HitRecord* best, bool* found,
+                                QueryScratch& scratch) {
+        using Node = WideBvhNode<kWidth>;
+        const int n = static_cast<int>(rays.size());
+        for (int r = 0; r < n; ++r) found[r] = false;
+        if (nodes.empty()) return;
+        PacketLanes<NodeTest> lanes;
+        std::uint32_t open = 0;
+        for (int r = 0; r < n; ++r) {
+            lanes.make(r, rays[r]);
+            if (!lanes[r].box.valid) continue;
+            best[r] = HitRecord{};
+            best[r].t = rays[r].t_max;
+            open |= 1u << r;
+        }
+        if (open == 0) return;
+#if CSGRT_BVH_AVX2
+        if constexpr (kAvx2Test<NodeTest>) {
+            PacketIntervalTest interval;
+            if (interval.accepts(lanes, open)) {
+                return walk_interval_packet<kAny>(bvh, rays, lanes, open, interval, best, found,
+                                                  scratch);
+            }
+            // Rays without a common origin (shadow rays from a surface, incoherent rays): the
+            // packet's interval would hold the region between their origins, where each of
+            // them tests every leaf near any of them; one at a time is faster.
+            TraversalCounters unused;
+            for (std::uint32_t m = open; m != 0; m &= m - 1) {
+                const int r = std::countr_zero(m);
+                if constexpr (kAny) {
+                    found[r] = occluded<false, true>(bvh, rays[r], scratch, unused);
+                } else {
+                    found[r] = intersect<false, true>(bvh, rays[r], best[r], scratch, unused);
+                }
+            }
+            return;
+        }
+#endif
+        for (std::uint32_t m = open; m != 0; m &= m - 1) lanes.make_test(std::countr_zero(m));
+
+        PacketEntry stack[(kWidth - 1) * kMaxDepth + 1];
+        PacketEntry* top = stack;
+        std::uint32_t first = 0, count = Node::kInterior, active = open;
+        for (;;) {
+            while (count == Node::kInterior && active != 0) {
+                const Node& node = nodes[first];
+                std::uint32_t child_rays[kWidth] = {};
+                float child_enter[kWidth];
+                std::fill_n(child_enter, kWidth, kFloatInfinity);
+                unsigned entered = 0;
+                for (std::uint32_t m = active; m != 0; m &= m - 1) {
+                    const int r = std::countr_zero(m);
+                    const auto& lane = lanes[r];
+                    const NodeTest& test = lanes.test(r);
+                    alignas(32) float t_enter[kWidth];
+                    const unsigned mask = lane.box.signed_interval
+                                              ? test.template hit<true>(node, lane.t_max, t_enter)
+                                              : test.template hit<false>(node, lane.t_max, t_enter);
+                    for (unsigned c = mask; c != 0; c &= c - 1) {
+                        const int slot = std::countr_zero(c);
+                        child_enter[slot] = std::min(child_enter[slot], t_enter[slot]);
+                        child_rays[slot] |= 1u << r;
+                    }
+                    entered |= mask;
+                }
+                if (entered == 0) break;
+                PacketEntry* pushed = top;
+                for (unsigned c = entered; c != 0; c &= c - 1) {
+                    const int slot = std::countr_zero(c);
+                    *top++ = PacketEntry{node.first[slot], node.count[slot], child_rays[slot],
+                                         child_enter[slot]};
+                    prefetch(bvh, nodes, node.first[slot], node.count[slot]);
+                }
+                for (PacketEntry* i = pushed + 1; i != top; ++i) {
+                    const PacketEntry entry = *i;
+                    PacketEntry* j = i;
+                    for (; j != pushed && (j - 1)->t_enter < entry.t_enter; --j) *j = *(j - 1);
+                    *j = entry;
+                }
+                --top;
+                first = top->first;
+                count = top->count;
+                active = top->rays;
+            }
+            if (count != Node::kInterior && count != 0) {
+                leaf_for_rays<kAny>(bvh, rays, lanes, active, first, count, best, found, open,
+                                    scratch);
+                if (open == 0) return;
+            }
+            // Each entry keeps the rays still open whose own entry may lie within their t_max
+            // (their least entry does not exceed it).
+            do {
+                if (top == stack) return;
+                --top;
+                active = top->rays & open;
+                for (std::uint32_t m = active; m != 0; m &= m - 1) {
+                    const int r = std::countr_zero(m);
+                    if (top->t_enter > lanes[r].t_max) active &= ~(1u << r);
+                }
+            } while (active == 0);
+            first = top->first;
+            count = top->count;
+        }
+    }
+
+#if CSGRT_BVH_AVX2
+    /// traverse_packet with the AVX2 node test, everything inlined and compiled for AVX2.
+    template <bool kAny>
+    [[gnu::target("avx2"), gnu::flatten]] static void traverse_packet_avx2(
+        const Tree& bvh, std::span<const Ray> rays, HitRecord* best, bool* found,
+        QueryScratch& scratch) {
+        traverse_packet<kAny, Avx2NodeTest>(bvh, bvh.nodes_8_, rays, best, found, scratch);
+    }
+#endif
+
+#if CSGRT_BVH_AVX2
+    /// The nearest hits (or occlusion) of a packet whose rays PacketIntervalTest accepts: the
+    /// tree is walked once with the packet's conservative node test, as one ray would walk it,
+    /// and every leaf it reaches is tested for each open ray with that ray's own leaf test and
+    /// t_max. The upper bound of the walk is the largest t_max of the open rays.
+    template <bool kAny>
+    [[gnu::target("avx2")]] static void walk_interval_packet(
+        const Tree& bvh, std::span<const Ray> rays, PacketLanes<Avx2NodeTest>& lanes,
+        std::uint32_t open, const PacketIntervalTest& test, HitRecord* best, bool* found,
+        QueryScratch& scratch) {
+        TraversalCounters unused;
+        auto largest_t_max = [&] {
+            float t_max = -kFloatInfinity;
+            for (std::uint32_t m = open; m != 0; m &= m - 1)
+                t_max = std::max(t_max, lanes[std::countr_zero(m)].t_max);
+            return t_max;
+        };
+        if constexpr (kBlockSet) {
+            if (!bvh.blocks_.empty()) {
+                // Ray-parallel leaves, when the rays share the triangle test's axes.
+                typename Set::PreparedRay prepared[Tree::kPacketRays];
+                for (std::uint32_t m = open; m != 0; m &= m - 1) {
+                    const int r = std::countr_zero(m);
+                    prepared[r] = bvh.set_->prepare(rays[r], scratch);
+                }
+                PacketTriangleRays triangle_rays;
+                if (triangle_rays.accepts(prepared, open)) {
+                    auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+                        const BvhTriangleBlock* block = bvh.blocks_.data() + first;
+                        for (std::uint32_t left = count; left != 0; ++block) {
+                            const std::uint32_t block_lanes = std::min(left, kBlockLanes);
+                            left -= block_lanes;
+                            for (std::uint32_t lane = 0; lane < block_lanes; ++lane) {
+                                alignas(32) float sheared[9][8];
+                                unsigned candidates = triangle_rays.candidates(
+                                    *block, static_cast<int>(lane), open, sheared);
+                                while (candidates != 0) {
+                                    const int r = std::countr_zero(candidates);
+                                    candidates &= candidates - 1;
+                                    TriangleSet<float>::ShearedTriangle triangle;
+                                    for (int k = 0; k < 3; ++k) {
+                                        triangle.x[k] = sheared[k][r];
+                                        triangle.y[k] = sheared[3 + k][r];
+                                        triangle.z[k] = sheared[6 + k][r];
+                                    }
+                                    double t, b1, b2;
+                                    if (!TriangleSet<float>::hit_sheared(
+                                            triangle, prepared[r].shear_z, t, b1, b2)) {
+                                        continue;
+                                    }
+                                    if constexpr (kAny) {
+                                        if (t >= prepared[r].t_min && t <= prepared[r].t_max) {
+                                            found[r] = true;
+                                            open &= ~(1u << r);
+                                        }
+                                    } else if (Set::keep_nearest(block->primitive[lane], t, b1, b2,
+                                                                 prepared[r], best[r])) {
+                                        found[r] = true;
+                                        lanes[r].t_max = round_up(best[r].t);
+                                    }
+                                }
+                                if (open == 0) return true;
+                            }
+                        }
+                        t_max = largest_t_max();
+                        return false;
+                    };
+                    walk_wide<false, false>(bvh, bvh.nodes_8_, test, largest_t_max(), unused, leaf);
+                    return;
+                }
+            }
+        }
+        auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+            leaf_for_rays<kAny>(bvh, rays, lanes, open, first, count, best, found, open, scratch);
+            t_max = largest_t_max();
+            return open == 0;
+        };
+        walk_wide<false, false>(bvh, bvh.nodes_8_, test, largest_t_max(), unused, leaf);
+    }
+#endif
+
+    /// Up to kPacketRays rays through the wide tree (width 4 or 8).
+    template <bool kAny>
+    static void packet(const Tree& bvh, std::span<const Ray> rays, HitRecord* best, bool* found,
+                       QueryScratch& scratch) {
+        if (bvh.config_.width == 8) {
+#if CSGRT_BVH_AVX2
+            if (bvh.use_avx2_) return traverse_packet_avx2<kAny>(bvh, rays, best, found, scratch);
+#endif
+            return traverse_packet<kAny, SseNodeTest<8>>(bvh, bvh.nodes_8_, rays, best, found,
+                                                         scratch);
+        }
+        traverse_packet<kAny, SseNodeTest<4>>(bvh, bvh.nodes_4_, rays, best, found, scratch);
+    }
+};
+
+}  // namespace detail
+
+template <class Set>
+template <bool kAny>
+std::size_t Bvh<Set>::trace_packets(std::span<const Ray> rays, std::span<HitRecord> records,
+                                    std::span<bool> hit, QueryScratch& scratch) const {
+    std::size_t hits = 0;
+    // Instance paths of a ShapeSet's hits live in the scratch of one query at a time, and the
+    // binary tree has no packet traversal: those go one ray at a time.
+    if (std::is_same_v<Set, ShapeSet> || config_.width == 2 || set_ == nullptr) {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            if constexpr (kAny) {
+                hit[i] = this->occluded(rays[i], scratch);
+            } else {
+                hit[i] = this->intersect(rays[i], records[i], scratch);
+            }
+            hits += hit[i] ? 1 : 0;
+        }
+        return hits;
+    }
+    if constexpr (!std::is_same_v<Set, ShapeSet>) {
+        HitRecord best[kPacketRays];
+        bool found[kPacketRays];
+        for (std::size_t begin = 0; begin < rays.size(); begin += kPacketRays) {
+            const std::size_t n = std::min(kPacketRays, rays.size() - begin);
+            detail::BvhTraversal<Set>::Packets::template packet<kAny>(*this, rays.subspan(begin, n),
+                                                                      best, found, scratch);
+            for (std::size_t r = 0; r < n; ++r) {
+                hit[begin + r] = found[r];
+                if constexpr (!kAny) {
+                    if (found[r]) records[begin + r] = best[r];
+                }
+                hits += found[r] ? 1 : 0;
+            }
+        }
+    }
+    return hits;
+}
+
+template <class Set>
+std::size_t Bvh<Set>::intersect_packets(std::span<const Ray> rays, std::span<HitRecord> records,
+                                        std::span<bool> hit, QueryScratch& scratch) const {
+    require(records.size() == rays.size(), "Bvh::intersect_packets", "records.size()",
+            "rays.size()", records.size());
+    require(hit.size() == rays.size(), "Bvh::intersect_packets", "hit.size()", "rays.size()",
+            hit.size());
+    return trace_packets<false>(rays, records, hit, scratch);
+}
+
+template <class Set>
+std::size_t Bvh<Set>::occluded_packets(std::span<const Ray> rays, std::span<bool> occluded,
+                                       QueryScratch& scratch) const {
+    require(occluded.size() == rays.size(), "Bvh::occluded_packets", "occluded.size()",
+            "rays.size()", occluded.size());
+    return trace_packets<true>(rays, {}, occluded, scratch);
+}
+
+template std::size_t Bvh<TriangleSet<float>>::intersect_packets(std::span<const Ray>,
+                                                                std::span<HitRecord>,
+                                                                std::span<bool>,
+                                                                QueryScratch&) const;
+template std::size_t Bvh<TriangleSet<float>>::occluded_packets(std::span<const Ray>,
+                                                               std::span<bool>,
+                                                               QueryScratch&) const;
+template std::size_t Bvh<TriangleSet<double>>::intersect_packets(std::span<const Ray>,
+                                                                 std::span<HitRecord>,
+                                                                 std::span<bool>,
+                                                                 QueryScratch&) const;
+template std::size_t Bvh<TriangleSet<double>>::occluded_packets(std::span<const Ray>,
+                                                                std::span<bool>,
+                                                                QueryScratch&) const;
+template std::size_t Bvh<ShapeSet>::intersect_packets(std::span<const Ray>, std::span<HitRecord>,
+                                                      std::span<bool>, QueryScratch&) const;
+template std::size_t Bvh<ShapeSet>::occluded_packets(std::span<const Ray>, std::span<bool>,
+                                                     QueryScratch&) const;
+
+}  // namespace csgrt
