@@ -44,14 +44,14 @@ struct RayTally {
     QueryCost centre_ray_cost;
     /// Sized to the scene's objects once per worker, so counting allocates nothing per ray.
     std::vector<std::uint64_t> hits_per_object;
-    /// Keyed by kind() literals; each map grows once per kind met, not per ray.
-    std::map<std::string_view, std::uint64_t> hits_by_leaf_kind;
-    std::map<std::string_view, std::uint64_t> solves_by_kind;
+    /// Keyed by kind() literals; each grows once per kind met, not per ray.
+    KindCounts hits_by_leaf_kind;
+    KindCounts solves_by_kind;
 
     void count_hit(const Hit& hit) {
         ++primary_hits;
         if (hit.object_id < hits_per_object.size()) ++hits_per_object[hit.object_id];
-        if (hit.shape != nullptr) ++hits_by_leaf_kind[hit.shape->kind()];
+        if (hit.shape != nullptr) hits_by_leaf_kind.add(hit.shape->kind());
     }
 };
 
@@ -225,13 +225,15 @@ Vector3 shade_surface(const Frame& frame, const Ray& ray, const Hit& hit, QueryS
     return radiance;
 }
 
-/// The ray through the centre of pixel (x, y), traced with its work counted at every level:
-/// the top-level structure's in `counters`, everything below it by a cost scope, summed into
-/// `cost`.
-std::optional<Hit> trace_centre_ray(const Frame& frame, int x, int y, QueryScratch& scratch,
+/// The ray through the centre of pixel (x, y).
+Ray centre_ray(const Frame& frame, int x, int y) {
+    return frame.film.ray((x + 0.5) / frame.settings.width, (y + 0.5) / frame.settings.height);
+}
+
+/// `centre` (a centre_ray) traced with its work counted at every level: the top-level
+/// structure's in `counters`, everything below it by a cost scope, summed into `cost`.
+std::optional<Hit> trace_centre_ray(const Frame& frame, const Ray& centre, QueryScratch& scratch,
                                     TraversalCounters& counters, QueryCost& cost) {
-    const Ray centre =
-        frame.film.ray((x + 0.5) / frame.settings.width, (y + 0.5) / frame.settings.height);
     std::optional<Hit> hit;
     {
         const CostScope counting(scratch, cost);
@@ -248,12 +250,12 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
     const double width = settings.width;
     const double height = settings.height;
 
-    // The AOVs come from one ray through the pixel centre.
-    const Ray centre = frame.film.ray((x + 0.5) / width, (y + 0.5) / height);
+    // The AOVs come from one ray through the pixel centre (with one sample, also its colour).
+    const Ray centre = centre_ray(frame, x, y);
     TraversalCounters counters;
     QueryCost cost;
     cost.solves_by_kind = &tally.solves_by_kind;
-    const std::optional<Hit> centre_hit = trace_centre_ray(frame, x, y, scratch, counters, cost);
+    const std::optional<Hit> centre_hit = trace_centre_ray(frame, centre, scratch, counters, cost);
     pixel.cost = static_cast<float>(cost.total());
     pixel.cost_nodes = static_cast<float>(cost.nodes);
     pixel.cost_primitives = static_cast<float>(cost.primitives);
@@ -395,10 +397,12 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
         result.stats.centre_ray_work.primitives_tested += tally.centre_ray_work.primitives_tested;
         result.stats.centre_ray_work.boxes_tested += tally.centre_ray_work.boxes_tested;
         result.stats.centre_ray_cost += tally.centre_ray_cost;
-        for (const auto& [kind, count] : tally.hits_by_leaf_kind)
+        tally.hits_by_leaf_kind.for_each([&](std::string_view kind, std::uint64_t count) {
             result.stats.hits_by_leaf_kind[std::string(kind)] += count;
-        for (const auto& [kind, count] : tally.solves_by_kind)
+        });
+        tally.solves_by_kind.for_each([&](std::string_view kind, std::uint64_t count) {
             result.stats.solves_by_kind[std::string(kind)] += count;
+        });
         for (std::size_t i = 0; i < tally.hits_per_object.size(); ++i) {
             result.stats.hits_per_object[i] += tally.hits_per_object[i];
         }
@@ -428,7 +432,7 @@ CostLayer render_cost(const Scene& scene, const RenderSettings& settings) {
     for_each_pixel(settings, workers, [&](int x, int y, QueryScratch& scratch, NoWorker&) {
         TraversalCounters counters;
         QueryCost cost;
-        trace_centre_ray(frame, x, y, scratch, counters, cost);
+        trace_centre_ray(frame, centre_ray(frame, x, y), scratch, counters, cost);
         const std::size_t i = std::size_t(y) * std::size_t(settings.width) + std::size_t(x);
         layer.nodes[i] = static_cast<float>(cost.nodes);
         layer.primitives[i] = static_cast<float>(cost.primitives);
