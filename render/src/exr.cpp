@@ -16,6 +16,7 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfThreading.h>
 #include <OpenEXR/ImfVecAttribute.h>
+#include <tbb/parallel_invoke.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -162,6 +163,11 @@ std::array<const std::vector<float>*, 4> channels_of(const CostLayer& layer) {
     return {&layer.nodes, &layer.primitives, &layer.solves, &layer.total};
 }
 
+/// zlib's fastest level. A 2048^2 showcase frame is 185 MB of channels; zipping them took
+/// 2.0 s of CPU at OpenEXR's default level 4 and takes 1.3 s at level 1, for a file 4% larger
+/// (24.4 MB instead of 23.3 MB). The pixels read back are the same at any level.
+constexpr int kZipLevel = 1;
+
 void write_exr_file(const std::filesystem::path& path, const Image& image,
                     const ExrMetadata& metadata, std::span<const CostLayer> cost_layers) {
     std::vector<Imf::Header> headers(kPartNames.size(), Imf::Header(image.width(), image.height()));
@@ -169,6 +175,7 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
         headers[part].setName(kPartNames[part]);
         headers[part].setType(Imf::SCANLINEIMAGE);
         headers[part].compression() = Imf::ZIP_COMPRESSION;
+        headers[part].zipCompressionLevel() = kZipLevel;
     }
     for (const ChannelSpec& channel : kChannels) {
         if (channel.legacy) continue;
@@ -468,10 +475,15 @@ void write_render_files(const std::filesystem::path& exr_path, const Image& imag
     for (const auto& target : targets)
         temporaries.push_back(std::make_unique<TemporaryFile>(target));
     try {
-        write_exr_file(temporaries[0]->path(), image, metadata, cost_layers);
-        write_colour_png(temporaries[1]->path(), image, tone_mapping);
-        write_cost_png(temporaries[2]->path(), image);
-        if (!cost_layers.empty()) write_cost_sheet_png(temporaries[3]->path(), cost_layers);
+        // The EXR (zipped on OpenEXR's threads) beside the previews: they share nothing but
+        // the image, which all of them only read.
+        tbb::parallel_invoke(
+            [&] { write_exr_file(temporaries[0]->path(), image, metadata, cost_layers); },
+            [&] {
+                write_colour_png(temporaries[1]->path(), image, tone_mapping);
+                write_cost_png(temporaries[2]->path(), image);
+                if (!cost_layers.empty()) write_cost_sheet_png(temporaries[3]->path(), cost_layers);
+            });
     } catch (const std::exception& error) {
         throw std::runtime_error("cannot write '" + exr_path.string() + "': " + error.what());
     }

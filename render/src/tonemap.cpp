@@ -28,9 +28,16 @@ std::string_view tone_curve_name(ToneCurve curve) {
 }
 
 double tone_map(double linear, const ToneMapping& mapping) {
+    return ToneMapper(mapping)(linear);
+}
+
+ToneMapper::ToneMapper(const ToneMapping& mapping)
+    : curve_(mapping.curve), scale_(std::exp2(mapping.exposure_stops)) {}
+
+double ToneMapper::operator()(double linear) const {
     // NaN-safe: a NaN or a negative value becomes 0 before the curve.
-    const double x = linear > 0.0 ? linear * std::exp2(mapping.exposure_stops) : 0.0;
-    switch (mapping.curve) {
+    const double x = linear > 0.0 ? linear * scale_ : 0.0;
+    switch (curve_) {
         case ToneCurve::Clamp:
             return std::min(x, 1.0);
         case ToneCurve::Reinhard:

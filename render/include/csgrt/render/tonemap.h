@@ -32,4 +32,16 @@ std::string_view tone_curve_name(ToneCurve curve);
 /// The display-linear value in [0, 1] for a linear value (NaN and negative values give 0).
 double tone_map(double linear, const ToneMapping& mapping);
 
+/// tone_map with the exposure's power of two computed once, for the pixels of a whole image:
+/// gives tone_map's values exactly.
+class ToneMapper {
+public:
+    explicit ToneMapper(const ToneMapping& mapping);
+    double operator()(double linear) const;
+
+private:
+    ToneCurve curve_;
+    double scale_;
+};
+
 }  // namespace csgrt
