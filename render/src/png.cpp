@@ -179,7 +179,7 @@ void write_colour_png(const std::filesystem::path& path, const Image& image,
                       const ToneMapping& mapping) {
     std::vector<std::uint8_t> rgb(3 * image.pixel_count());
     const ToneMapper tone(mapping);
-    const std::vector<Pixel>& pixels = image.pixels();
+    const Image::Pixels& pixels = image.pixels();
     // Rows in parallel: each byte depends on its own pixel only.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels.size(), kPixelsPerTask),
                       [&](const tbb::blocked_range<std::size_t>& range) {
@@ -365,7 +365,7 @@ void write_cost_png(const std::filesystem::path& path, const Image& image) {
     std::vector<std::uint8_t> rgb(3 * static_cast<std::size_t>(width) * height, 0);
     Canvas canvas{width, height, rgb};
     const CostColours colours(max_cost, image.pixel_count());
-    const std::vector<Pixel>& pixels = image.pixels();
+    const Image::Pixels& pixels = image.pixels();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels.size(), kPixelsPerTask),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                           for (std::size_t i = range.begin(); i != range.end(); ++i) {

@@ -36,6 +36,30 @@ struct Pixel {
     float cost_solves = 0.0f;
 };
 
+/// The allocator of an image's pixels: blocks of 2 MiB and more are aligned to 2 MiB and the
+/// kernel is asked to back them with transparent huge pages (madvise), so that a 2048^2 image
+/// (218 MB) is faulted in about 100 pieces rather than 53,000 pages of 4 KiB: those faults
+/// were 40% of the time of an empty 2048^2 frame. Smaller blocks come from operator new.
+void* allocate_pixel_memory(std::size_t bytes);
+void free_pixel_memory(void* pointer, std::size_t bytes);
+
+template <class T>
+struct PixelAllocator {
+    using value_type = T;
+
+    PixelAllocator() = default;
+    template <class U>
+    PixelAllocator(const PixelAllocator<U>&) {}
+
+    T* allocate(std::size_t count) { return static_cast<T*>(allocate_pixel_memory(count * sizeof(T))); }
+    void deallocate(T* pointer, std::size_t count) { free_pixel_memory(pointer, count * sizeof(T)); }
+
+    template <class U>
+    bool operator==(const PixelAllocator<U>&) const {
+        return true;
+    }
+};
+
 /// A rendered image: width x height pixels, row-major from the top-left corner.
 class Image {
 public:
@@ -49,8 +73,9 @@ public:
 
     Pixel& at(int x, int y) { return pixels_[index(x, y)]; }
     const Pixel& at(int x, int y) const { return pixels_[index(x, y)]; }
-    std::vector<Pixel>& pixels() { return pixels_; }
-    const std::vector<Pixel>& pixels() const { return pixels_; }
+    using Pixels = std::vector<Pixel, PixelAllocator<Pixel>>;
+    Pixels& pixels() { return pixels_; }
+    const Pixels& pixels() const { return pixels_; }
 
 private:
     std::size_t index(int x, int y) const {
@@ -60,7 +85,7 @@ private:
 
     int width_ = 0;
     int height_ = 0;
-    std::vector<Pixel> pixels_;
+    Pixels pixels_;
 };
 
 /// The cost channels of one render of a scene whose every structure is one kind
