@@ -29,6 +29,19 @@ template <QueryKind kKind, class Base>
     return found;
 }
 
+/// The every-hit walk made while a CostScope is open (a mesh's spans as a CSG operand, a
+/// large compound's): the counted walk of the structure's query, its work added to the
+/// scratch's cost. Out of line, as above.
+template <class Structure>
+[[gnu::noinline]] void all_hits_into_cost(const Structure& structure, const Ray& ray,
+                                          std::vector<HitRecord>& hits, QueryScratch& scratch) {
+    TraversalCounters counters;
+    structure.template query<QueryKind::kAll, true>(ray, hits, scratch, counters);
+    QueryCost* cost = scratch.cost();
+    cost->nodes += counters.nodes_visited;
+    cost->primitives += counters.primitives_tested;
+}
+
 }  // namespace detail
 
 template <class Derived, class Set>
@@ -71,6 +84,10 @@ bool AcceleratorBase<Derived, Set>::occluded_counted(const Ray& ray, QueryScratc
 template <class Derived, class Set>
 void AcceleratorBase<Derived, Set>::all_hits(const Ray& ray, std::vector<HitRecord>& hits,
                                              QueryScratch& scratch) const {
+    if (scratch.cost() != nullptr) [[unlikely]] {
+        detail::all_hits_into_cost(derived(), ray, hits, scratch);
+        return;
+    }
     TraversalCounters unused;
     derived().template query<QueryKind::kAll, false>(ray, hits, scratch, unused);
 }

@@ -86,7 +86,7 @@ struct BvhTraversal {
             return occluded<kCount, kAvx2>(bvh, ray, scratch, counters);
         } else {
             const std::size_t before = answer.size();
-            all_hits<kAvx2>(bvh, ray, answer, scratch);
+            all_hits<kCount, kAvx2>(bvh, ray, answer, scratch, counters);
             return answer.size() > before;
         }
     }
@@ -460,25 +460,26 @@ struct BvhTraversal {
         return occluded;
     }
 
-    template <bool kAvx2>
+    /// Every hit in the interval, the leaves' and nodes' work counted when kCount (a mesh's
+    /// spans as a CSG operand are this walk).
+    template <bool kCount, bool kAvx2>
     static void all_hits(const Tree& bvh, const Ray& ray, std::vector<HitRecord>& hits,
-                         QueryScratch& scratch) {
+                         QueryScratch& scratch, TraversalCounters& counters) {
         if (bvh.set_ == nullptr) return;
         const BoxRay box_ray(ray);
         if (!box_ray.valid) return;
         const LeafRayOf<kAvx2> leaf_ray(*bvh.set_, ray, scratch);
-        TraversalCounters unused;
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
-            return for_each_hit<false>(bvh, leaf_ray, first, count, unused,
-                                       [&](const auto& candidate) {
-                                           HitRecord record;
-                                           record.t = ray.t_max;
-                                           if (candidate.keep_nearest(record))
-                                               hits.push_back(record);
-                                           return false;
-                                       });
+            return for_each_hit<kCount>(bvh, leaf_ray, first, count, counters,
+                                        [&](const auto& candidate) {
+                                            HitRecord record;
+                                            record.t = ray.t_max;
+                                            if (candidate.keep_nearest(record))
+                                                hits.push_back(record);
+                                            return false;
+                                        });
         };
-        traverse<false, kAvx2>(bvh, ray, box_ray, unused, leaf);
+        traverse<kCount, kAvx2>(bvh, ray, box_ray, counters, leaf);
     }
 
     /// The packet queries (bvh_packet.cpp): a member, so that they share the traversal's

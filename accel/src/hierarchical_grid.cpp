@@ -121,24 +121,30 @@ struct AnyVisitor {
 };
 
 /// Every hit in the interval: the whole ray is walked.
-template <class Set>
+template <class Set, bool kCount>
 struct AllVisitor {
     AllVisitor(const Set& set, const typename Set::PreparedRay& prepared, double t_max,
-               std::vector<HitRecord>& hits)
-        : set(set), prepared(prepared), t_max(t_max), hits(hits) {}
+               std::vector<HitRecord>& hits, TraversalCounters& counters)
+        : set(set), prepared(prepared), t_max(t_max), hits(hits), counters(counters) {}
 
     const Set& set;
     const typename Set::PreparedRay& prepared;
     double t_max;
     std::vector<HitRecord>& hits;
+    TraversalCounters& counters;
     detail::Mailbox mailbox;
 
-    void count_box() {}
-    void count_cell() {}
+    void count_box() {
+        if constexpr (kCount) ++counters.boxes_tested;
+    }
+    void count_cell() {
+        if constexpr (kCount) ++counters.nodes_visited;
+    }
     bool leaf(std::span<const std::uint32_t> list) {
         detail::prefetch_primitives(set, list.data(), list.data() + list.size());
         for (const std::uint32_t primitive : list) {
             if (!mailbox.first_visit(primitive)) continue;
+            if constexpr (kCount) ++counters.primitives_tested;
             HitRecord record;
             record.t = t_max;
             if (set.intersect(primitive, prepared, record)) hits.push_back(record);
@@ -341,12 +347,14 @@ bool HierarchicalGrid<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
 }
 
 template <class Set>
+template <bool kCount>
 void HierarchicalGrid<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits,
-                                          QueryScratch& scratch) const {
+                                          QueryScratch& scratch,
+                                          TraversalCounters& counters) const {
     if (set_ == nullptr || !is_valid(ray)) return;
     const auto prepared = set_->prepare(ray, scratch);
     const std::size_t first = hits.size();
-    AllVisitor<Set> visitor(*set_, prepared, ray.t_max, hits);
+    AllVisitor<Set, kCount> visitor(*set_, prepared, ray.t_max, hits, counters);
     visitor.leaf(unbounded_);
     if (!grids_.empty()) traverse(0, ray, ray.direction.cwiseInverse(), visitor);
     detail::drop_repeated_hits<Set>(hits, first);

@@ -695,13 +695,20 @@ bool RayClassification<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch
 }
 
 template <class Set>
+template <bool kCount>
 void RayClassification<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits,
-                                           QueryScratch& scratch) const {
+                                           QueryScratch& scratch,
+                                           TraversalCounters& counters) const {
     if (set_ == nullptr || !is_valid(ray)) return;
-    TraversalCounters unused;
-    const Search search = find_candidates(ray, unused);
+    TraversalCounters local;
+    const Search search = find_candidates(ray, local);
+    if constexpr (kCount) {
+        counters.nodes_visited += local.nodes_visited;
+        counters.boxes_tested += local.boxes_tested;
+    }
     const auto prepared = set_->prepare(ray, scratch);
     auto collect = [&](std::uint32_t index) {
+        if constexpr (kCount) ++counters.primitives_tested;
         HitRecord hit;
         hit.t = ray.t_max;
         if (set_->intersect(index, prepared, hit)) hits.push_back(hit);
@@ -717,6 +724,7 @@ void RayClassification<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord
         stack[top++] = search.candidates[k].cluster;
         while (top > 0) {
             const BvhNode& node = clusters_[stack[--top]];
+            if constexpr (kCount) ++counters.boxes_tested;
             if (!hits_box(node, ray.origin, inverse_direction, ray.t_min, ray.t_max)) continue;
             if (node.is_leaf()) {
                 for (std::uint32_t j = node.offset; j < node.offset + node.count; ++j)

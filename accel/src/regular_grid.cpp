@@ -283,12 +283,14 @@ bool RegularGrid<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
 }
 
 template <class Set>
+template <bool kCount>
 void RegularGrid<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits,
-                                     QueryScratch& scratch) const {
+                                     QueryScratch& scratch, TraversalCounters& counters) const {
     if (set_ == nullptr || !is_valid(ray)) return;
     const auto prepared = set_->prepare(ray, scratch);
     const std::size_t first = hits.size();
     auto test = [&](std::uint32_t primitive) {
+        if constexpr (kCount) ++counters.primitives_tested;
         HitRecord record;
         record.t = ray.t_max;
         if (set_->intersect(primitive, prepared, record)) hits.push_back(record);
@@ -296,12 +298,14 @@ void RegularGrid<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hit
     for (const std::uint32_t primitive : unbounded_) test(primitive);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     double t_enter, t_exit;
+    if constexpr (kCount) ++counters.boxes_tested;
     if (!primitives_.empty() &&
         detail::clip_to_box(geometry_.bounds, ray, inverse_direction, t_enter, t_exit)) {
         detail::Mailbox mailbox;
         detail::walk_cells(
             geometry_, ray, inverse_direction, t_enter, t_exit,
             [&](std::size_t cell, double) {
+                if constexpr (kCount) ++counters.nodes_visited;
                 if (!is_occupied(cell)) return false;
                 const std::uint32_t end = offsets_[cell + 1];
                 for (std::uint32_t k = offsets_[cell]; k < end; ++k) {

@@ -13,7 +13,7 @@ namespace csgrt::detail {
 /// A friend of each such structure, so its three walks stay private.
 struct SplitQuery {
     /// Answers `kKind` on `structure` through its intersect_impl<kCounted> (nearest),
-    /// occluded_impl<kCounted> (any) or all_hits_impl (all: that walk keeps no counters).
+    /// occluded_impl<kCounted> (any) or all_hits_impl<kCounted> (all).
     /// Returns whether the query found something, as AcceleratorBase expects.
     template <QueryKind kKind, bool kCounted, class Structure>
     static bool query(const Structure& structure, const Ray& ray, QueryAnswer<kKind>& answer,
@@ -24,7 +24,7 @@ struct SplitQuery {
             return structure.template occluded_impl<kCounted>(ray, scratch, counters);
         } else {
             const std::size_t before = answer.size();
-            structure.all_hits_impl(ray, answer, scratch);
+            structure.template all_hits_impl<kCounted>(ray, answer, scratch, counters);
             return answer.size() > before;
         }
     }

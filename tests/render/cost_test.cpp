@@ -87,6 +87,36 @@ TEST(Cost, ACsgDifferenceCountsItsBoxTestsAndEachOperandsSpans) {
     EXPECT_EQ(cost_of(scene, ray_along_z(2.0, 2.0)), (QueryCost{1, 1, 0}));
 }
 
+TEST(Cost, AMeshAsACsgOperandCountsItsEveryHitWalk) {
+    // A sphere mesh (512 triangles, brute force) minus a ball of radius 0.5 at (1, 0, 0). Its
+    // spans come from its structure's every-hit walk, which brute force makes over all 512
+    // triangles; the CSG node's box tests and the ball's one solve are as for analytic
+    // operands (ACsgDifferenceCountsItsBoxTestsAndEachOperandsSpans).
+    const test::TestMesh sphere = test::sphere_mesh(3);
+    const auto mesh_with = [&](const std::string& structure) {
+        MeshConfig config;
+        config.accelerator = structure;
+        return std::make_shared<Mesh>(TriangleMeshData{sphere.vertices, sphere.triangles, {}},
+                                      config);
+    };
+    const auto bitten = [&](const std::string& structure) {
+        return scene_of(make_difference(mesh_with(structure),
+                                        {std::make_shared<Sphere>(Point3(1, 0, 0), 0.5)}));
+    };
+    // Through both operands (x = 0.8 is inside the mesh: its faces are within 2% of the
+    // unit sphere): the mesh's walk, 512 primitive tests, besides the scene's one.
+    EXPECT_EQ(cost_of(bitten("brute"), ray_along_z(0.8, 0.0)), (QueryCost{3, 1 + 512, 1}));
+    // Every other structure walks its nodes or cells and tests fewer triangles, but some.
+    for (const std::string_view name : accelerator_names()) {
+        if (name == "brute") continue;
+        const QueryCost cost = cost_of(bitten(std::string(name)), ray_along_z(0.8, 0.0));
+        EXPECT_GT(cost.nodes, 3u) << name;
+        EXPECT_GT(cost.primitives, 1u) << name;
+        EXPECT_LT(cost.primitives, 1u + 512u) << name;
+        EXPECT_EQ(cost.solves, 1u) << name;
+    }
+}
+
 TEST(Cost, ACompoundCountsItsBoxItsStructureAndItsChildren) {
     std::vector<std::shared_ptr<const Shape>> children;
     for (int i = 0; i < 3; ++i) {

@@ -196,7 +196,9 @@ private:
                         TraversalCounters& counters) const;
     template <bool kCount>
     bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
-    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
+    template <bool kCount>
+    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch,
+                       TraversalCounters& counters) const;
 
     const Set* set_ = nullptr;
     RayClassificationConfig config_;

@@ -94,7 +94,9 @@ private:
                         TraversalCounters& counters) const;
     template <bool kCount>
     bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
-    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch) const;
+    template <bool kCount>
+    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch,
+                       TraversalCounters& counters) const;
     using AcceleratorBase<RegularGrid<Set>, Set>::stats_;
     bool is_occupied(std::size_t cell) const { return (occupied_[cell / 64] >> (cell % 64)) & 1; }
 
