@@ -61,6 +61,10 @@ private:
     Aabb first_bounds_;
     Aabb second_bounds_;
     Aabb bounds_;
+    /// The boxes' is_empty(), found once.
+    bool first_empty_ = false;
+    bool second_empty_ = false;
+    bool bounds_empty_ = false;
     /// The operands' span coincidence tolerance (span_coincidence_relative): float-sized when
     /// either holds a float mesh.
     double coincidence_ = kDoubleSpanCoincidence;
