@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "csgrt/core/error.h"
+#include "flat_shape.h"
 
 namespace csgrt {
 
@@ -14,13 +15,10 @@ Annulus::Annulus(const Point3& center, const Normal3& normal, double inner_radiu
       outer_radius_(outer_radius),
       azimuth_(phi_min, phi_max, "Annulus") {
     require_finite(center, "Annulus", "center");
-    require_finite(normal, "Annulus", "normal");
-    const Normal3 unit = detail::normalized_or_zero(normal);
-    require(unit.squaredNorm() > 0.0, "Annulus", "normal", "non-zero", normal);
+    frame_ = detail::frame_of_normal(normal, "Annulus");
     require_positive(outer_radius, "Annulus", "outer_radius");
     require(inner_radius >= 0.0 && inner_radius < outer_radius, "Annulus", "inner_radius",
             "in [0, outer_radius)", inner_radius);
-    frame_ = SurfaceFrame::around(unit);
 }
 
 Aabb Annulus::bounds() const {

@@ -6,6 +6,7 @@
 #include "csgrt/core/angle_range.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/polynomial.h"
+#include "solid_interval.h"
 
 namespace csgrt {
 
@@ -156,15 +157,7 @@ detail::LineInterval Cone::solid_interval(const Ray& ray) const {
 
 std::optional<Crossing> Cone::crossing(const Ray& ray) const {
     if (capped_) {
-        const detail::LineInterval span = solid_interval(ray);
-        if (span.empty()) return {};
-        if (ray.in_range(span.t0) && std::isfinite(span.t0)) {
-            return Crossing{.t = span.t0, .primitive = span.surface0};
-        }
-        if (ray.in_range(span.t1) && std::isfinite(span.t1)) {
-            return Crossing{.t = span.t1, .primitive = span.surface1};
-        }
-        return {};
+        return detail::first_crossing(solid_interval(ray), ray);
     }
     Crossing crossing;
     const bool found = detail::nearest_open_surface_hit(
@@ -183,13 +176,7 @@ void Cone::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) co
     count_solve(scratch, *this);
     spans.clear();
     if (!capped_) return;
-    const detail::LineInterval span = solid_interval(ray);
-    if (span.empty() || span.t1 < ray.t_min || span.t0 > ray.t_max || !std::isfinite(span.t0) ||
-        !std::isfinite(span.t1)) {
-        return;
-    }
-    spans.push_back(Span{HitRecord{.t = span.t0, .shape = this, .primitive = span.surface0},
-                         HitRecord{.t = span.t1, .shape = this, .primitive = span.surface1}});
+    detail::push_span(solid_interval(ray), ray, this, spans);
 }
 
 bool Cone::contains(const Point3& p) const {

@@ -6,9 +6,9 @@
 #include "csgrt/core/angle_range.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/polynomial.h"
+#include "solid_interval.h"
 
 namespace csgrt {
-
 
 Cylinder::Cylinder(double radius, double y_min, double y_max, bool capped)
     : radius_(radius), y_min_(y_min), y_max_(y_max), capped_(capped) {
@@ -35,32 +35,17 @@ std::optional<Crossing> Cylinder::crossing(const Ray& ray) const {
     }
     // The solid is the infinite solid cylinder cut by the slab: its span is the overlap of the
     // two intervals, so the rim is watertight by construction (no point-in-disk test).
-    const detail::LineInterval span = detail::overlap(side, slab);
-    if (span.empty()) return {};
-    if (ray.in_range(span.t0) && std::isfinite(span.t0)) {
-        return Crossing{.t = span.t0, .primitive = span.surface0};
-    }
-    if (ray.in_range(span.t1) && std::isfinite(span.t1)) {
-        return Crossing{.t = span.t1, .primitive = span.surface1};
-    }
-    return {};
+    return detail::first_crossing(detail::overlap(side, slab), ray);
 }
 
 void Cylinder::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
     count_solve(scratch, *this);
     spans.clear();
     if (!capped_) return;
-    const detail::LineInterval span =
+    detail::push_span(
         detail::overlap(detail::infinite_cylinder_interval(ray, radius_, kSide),
-                        detail::slab_interval(ray, y_min_, y_max_, kBottomCap, kTopCap));
-    // A bounded solid has finite span ends; infinite ones only arise from underflowed
-    // directions, which cross nothing.
-    if (span.empty() || span.t1 < ray.t_min || span.t0 > ray.t_max || !std::isfinite(span.t0) ||
-        !std::isfinite(span.t1)) {
-        return;
-    }
-    spans.push_back(Span{HitRecord{.t = span.t0, .shape = this, .primitive = span.surface0},
-                         HitRecord{.t = span.t1, .shape = this, .primitive = span.surface1}});
+                        detail::slab_interval(ray, y_min_, y_max_, kBottomCap, kTopCap)),
+        ray, this, spans);
 }
 
 bool Cylinder::contains(const Point3& p) const {

@@ -4,17 +4,15 @@
 #include <cmath>
 
 #include "csgrt/core/error.h"
+#include "flat_shape.h"
 
 namespace csgrt {
 
 Disk::Disk(const Point3& center, const Normal3& normal, double radius)
     : center_(center), radius_(radius) {
     require_finite(center, "Disk", "center");
-    require_finite(normal, "Disk", "normal");
-    const Normal3 unit = detail::normalized_or_zero(normal);
-    require(unit.squaredNorm() > 0.0, "Disk", "normal", "non-zero", normal);
+    frame_ = detail::frame_of_normal(normal, "Disk");
     require_positive(radius, "Disk", "radius");
-    frame_ = SurfaceFrame::around(unit);
 }
 
 Aabb Disk::bounds() const {

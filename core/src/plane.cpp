@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "csgrt/core/error.h"
+#include "flat_shape.h"
 
 namespace csgrt {
-
 
 namespace {
 
@@ -20,10 +20,7 @@ double wrap_unit(double x) {
 
 Plane::Plane(const Point3& point, const Normal3& normal) : point_(point) {
     require_finite(point, "Plane", "point");
-    require_finite(normal, "Plane", "normal");
-    const Normal3 unit = detail::normalized_or_zero(normal);
-    require(unit.squaredNorm() > 0.0, "Plane", "normal", "non-zero", normal);
-    frame_ = SurfaceFrame::around(unit);
+    frame_ = detail::frame_of_normal(normal, "Plane");
 }
 
 std::optional<Crossing> Plane::crossing(const Ray& ray) const {
@@ -33,18 +30,9 @@ std::optional<Crossing> Plane::crossing(const Ray& ray) const {
 }
 
 Hit Plane::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
     Vector3 offset = ray.at(record.t) - point_;
-    // Drop the component along the normal that o + t d picked up by rounding.
-    offset -= offset.dot(frame_.normal) * frame_.normal;
-    hit.point = point_ + offset;
-    hit.geometric_normal = frame_.normal;
-    hit.shading_normal = frame_.normal;
+    Hit hit = detail::flat_hit(ray, record, this, point_, offset, frame_.normal);
     hit.uv = Vector2(wrap_unit(offset.dot(frame_.x_axis)), wrap_unit(offset.dot(frame_.z_axis)));
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(frame_.normal) < 0.0;
     return hit;
 }
 

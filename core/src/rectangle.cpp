@@ -5,6 +5,7 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/core/plane.h"
+#include "flat_shape.h"
 
 namespace csgrt {
 
@@ -52,19 +53,10 @@ std::optional<Crossing> Rectangle::crossing(const Ray& ray) const {
 }
 
 Hit Rectangle::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
     Vector3 offset = (ray.origin - corner_) + record.t * ray.direction;
-    // Back onto the plane: removes the rounding of o + t d along the normal.
-    offset -= offset.dot(normal_) * normal_;
-    hit.point = corner_ + offset;
-    hit.geometric_normal = normal_;
-    hit.shading_normal = normal_;
+    Hit hit = detail::flat_hit(ray, record, this, corner_, offset, normal_);
     hit.uv =
         Vector2(std::clamp(double(record.u), 0.0, 1.0), std::clamp(double(record.v), 0.0, 1.0));
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(normal_) < 0.0;
     return hit;
 }
 

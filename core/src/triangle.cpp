@@ -6,6 +6,7 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/core/plane.h"
+#include "flat_shape.h"
 
 namespace csgrt {
 
@@ -94,13 +95,12 @@ inline std::optional<Crossing> watertight_crossing(const Vector3& a, const Vecto
         return {};
     const double t = t_scaled / det;
     if (!(t >= t_min && t <= t_max)) return {};
-    return Crossing{
-        .t = t, .u = static_cast<float>(e1 / det), .v = static_cast<float>(e2 / det)};
+    return Crossing{.t = t, .u = static_cast<float>(e1 / det), .v = static_cast<float>(e2 / det)};
 }
 
 /// The slow path of Triangle::crossing for corners whose coordinates overflow t's numerator.
 [[gnu::noinline]] std::optional<Crossing> scaled_crossing(const Vector3& a, const Vector3& b,
-                                                         const Vector3& c, const Ray& ray) {
+                                                          const Vector3& c, const Ray& ray) {
     bool overflow = false;
     // Coordinates beyond about 2^340 overflow the cubic numerator of t (a hit at infinity, or
     // NaN). Scaling them by a power of two is exact, keeps every edge function's sign (so the
@@ -110,10 +110,9 @@ inline std::optional<Crossing> watertight_crossing(const Vector3& a, const Vecto
     if (!std::isfinite(extent)) return {};
     const int exponent = std::ilogb(extent);
     const double scale = std::ldexp(1.0, -exponent);
-    std::optional<Crossing> scaled =
-        watertight_crossing(a * scale, b * scale, c * scale, ray.direction,
-                            std::ldexp(ray.t_min, -exponent), std::ldexp(ray.t_max, -exponent),
-                            overflow);
+    std::optional<Crossing> scaled = watertight_crossing(
+        a * scale, b * scale, c * scale, ray.direction, std::ldexp(ray.t_min, -exponent),
+        std::ldexp(ray.t_max, -exponent), overflow);
     if (scaled) scaled->t = std::ldexp(scaled->t, exponent);
     return scaled;
 }
@@ -133,19 +132,10 @@ std::optional<Crossing> Triangle::crossing(const Ray& ray) const {
 }
 
 Hit Triangle::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
     Vector3 offset = ray.at(record.t) - vertices_[0];
-    // Back onto the triangle's plane: removes the rounding of o + t d along the normal.
-    offset -= offset.dot(normal_) * normal_;
-    hit.point = vertices_[0] + offset;
-    hit.geometric_normal = normal_;
-    hit.shading_normal = normal_;
+    Hit hit = detail::flat_hit(ray, record, this, vertices_[0], offset, normal_);
     hit.uv =
         Vector2(std::clamp(double(record.u), 0.0, 1.0), std::clamp(double(record.v), 0.0, 1.0));
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(normal_) < 0.0;
     return hit;
 }
 

@@ -4,6 +4,7 @@
 
 #include "csgrt/core/error.h"
 #include "support/error_of.h"
+#include "support/leaf_checks.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -107,30 +108,11 @@ TEST(Annulus, RayStartingOnIt) {
 
 TEST(Annulus, IntervalHonouredAtBothEnds) {
     const Ray ray = down_at(1.5, 0);  // crosses at t = 4
-    Ray clipped = ray;
-    clipped.t_max = next_down(4.0);
-    EXPECT_FALSE(kRing.intersect(clipped));
-    EXPECT_FALSE(kRing.occluded(clipped));
-    clipped.t_max = 4.0;
-    EXPECT_TRUE(kRing.intersect(clipped));
-    EXPECT_TRUE(kRing.occluded(clipped));
-    clipped = ray;
-    clipped.t_min = 4.0;
-    EXPECT_TRUE(kRing.intersect(clipped));
-    clipped.t_min = next_up(4.0);
-    EXPECT_FALSE(kRing.intersect(clipped));
-    EXPECT_FALSE(kRing.occluded(clipped));
+    test::expect_interval_honoured(kRing, ray, 4.0);
 }
 
 TEST(Annulus, InvalidRaysNeverHit) {
-    const double nan = std::nan("");
-    for (const Ray& ray :
-         {Ray{Point3(nan, 5, 0), Vector3(0, -1, 0)}, Ray{Point3(1.5, 5, 0), Vector3(0, nan, 0)},
-          Ray{Point3(1.5, 5, 0), Vector3(0, 0, 0)},
-          Ray{Point3(1.5, kInfinity, 0), Vector3(0, -1, 0)},
-          Ray{Point3(1.5, 5, 0), Vector3(0, -kInfinity, 0)},
-          Ray{Point3(1.5, 5, 0), Vector3(0, -1, 0), nan, kInfinity},
-          Ray{Point3(1.5, 5, 0), Vector3(0, -1, 0), 5.0, 4.0}}) {
+    for (const Ray& ray : test::invalid_variants(Ray{Point3(1.5, 5, 0), Vector3(0, -1, 0)})) {
         EXPECT_FALSE(kRing.intersect(ray));
         EXPECT_FALSE(kRing.occluded(ray));
         EXPECT_FALSE(kQuarter.intersect(ray));

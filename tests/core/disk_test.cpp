@@ -4,6 +4,7 @@
 
 #include "csgrt/core/error.h"
 #include "support/error_of.h"
+#include "support/leaf_checks.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -72,29 +73,11 @@ TEST(Disk, RayStartingOnTheDisk) {
 
 TEST(Disk, IntervalHonouredAtBothEnds) {
     const Ray ray{Point3(0.5, 5, 0), Vector3(0, -1, 0)};  // crosses at t = 4
-    Ray clipped = ray;
-    clipped.t_max = std::nextafter(4.0, 0.0);
-    EXPECT_FALSE(kDisk.intersect(clipped));
-    EXPECT_FALSE(kDisk.occluded(clipped));
-    clipped.t_max = 4.0;
-    EXPECT_TRUE(kDisk.intersect(clipped));
-    EXPECT_TRUE(kDisk.occluded(clipped));
-    clipped = ray;
-    clipped.t_min = 4.0;
-    EXPECT_TRUE(kDisk.intersect(clipped));
-    clipped.t_min = std::nextafter(4.0, 5.0);
-    EXPECT_FALSE(kDisk.intersect(clipped));
-    EXPECT_FALSE(kDisk.occluded(clipped));
+    test::expect_interval_honoured(kDisk, ray, 4.0);
 }
 
 TEST(Disk, InvalidRaysNeverHit) {
-    const double nan = std::nan("");
-    for (const Ray& ray :
-         {Ray{Point3(nan, 5, 0), Vector3(0, -1, 0)}, Ray{Point3(0, 5, 0), Vector3(0, nan, 0)},
-          Ray{Point3(0, 5, 0), Vector3(0, 0, 0)}, Ray{Point3(0, kInfinity, 0), Vector3(0, -1, 0)},
-          Ray{Point3(0, 5, 0), Vector3(0, -kInfinity, 0)},
-          Ray{Point3(0, 5, 0), Vector3(0, -1, 0), nan, kInfinity},
-          Ray{Point3(0, 5, 0), Vector3(0, -1, 0), 5.0, 4.0}}) {
+    for (const Ray& ray : test::invalid_variants(Ray{Point3(0, 5, 0), Vector3(0, -1, 0)})) {
         EXPECT_FALSE(kDisk.intersect(ray));
         EXPECT_FALSE(kDisk.occluded(ray));
     }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "csgrt/core/error.h"
+#include "support/leaf_checks.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -67,19 +68,7 @@ TEST(Plane, RayStartingOnThePlane) {
 
 TEST(Plane, IntervalHonouredAtBothEnds) {
     const Ray ray{Point3(0, 5, 0), Vector3(0, -1, 0)};  // crosses at t = 4
-    Ray clipped = ray;
-    clipped.t_max = std::nextafter(4.0, 0.0);
-    EXPECT_FALSE(kGround.intersect(clipped));
-    EXPECT_FALSE(kGround.occluded(clipped));
-    clipped.t_max = 4.0;
-    EXPECT_TRUE(kGround.intersect(clipped));
-    EXPECT_TRUE(kGround.occluded(clipped));
-    clipped = ray;
-    clipped.t_min = 4.0;
-    EXPECT_TRUE(kGround.intersect(clipped));
-    clipped.t_min = std::nextafter(4.0, 5.0);
-    EXPECT_FALSE(kGround.intersect(clipped));
-    EXPECT_FALSE(kGround.occluded(clipped));
+    test::expect_interval_honoured(kGround, ray, 4.0);
     // A negative interval reaches behind the origin.
     const Ray backwards{Point3(0, 5, 0), Vector3(0, 1, 0), -kInfinity, 0.0};
     ASSERT_TRUE(kGround.intersect(backwards));
@@ -87,13 +76,7 @@ TEST(Plane, IntervalHonouredAtBothEnds) {
 }
 
 TEST(Plane, InvalidRaysNeverHit) {
-    const double nan = std::nan("");
-    for (const Ray& ray :
-         {Ray{Point3(nan, 5, 0), Vector3(0, -1, 0)}, Ray{Point3(0, 5, 0), Vector3(0, nan, 0)},
-          Ray{Point3(0, 5, 0), Vector3(0, 0, 0)}, Ray{Point3(0, kInfinity, 0), Vector3(0, -1, 0)},
-          Ray{Point3(0, 5, 0), Vector3(0, -kInfinity, 0)},
-          Ray{Point3(0, 5, 0), Vector3(0, -1, 0), nan, kInfinity},
-          Ray{Point3(0, 5, 0), Vector3(0, -1, 0), 5.0, 4.0}}) {
+    for (const Ray& ray : test::invalid_variants(Ray{Point3(0, 5, 0), Vector3(0, -1, 0)})) {
         EXPECT_FALSE(kGround.intersect(ray));
         EXPECT_FALSE(kGround.occluded(ray));
         EXPECT_TRUE(kGround.spans(ray).empty());

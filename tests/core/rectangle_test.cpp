@@ -6,6 +6,7 @@
 
 #include "csgrt/core/error.h"
 #include "support/error_of.h"
+#include "support/leaf_checks.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -75,29 +76,11 @@ TEST(Rectangle, RayStartingOnItAndPointingAway) {
 
 TEST(Rectangle, IntervalHonouredAtBothEnds) {
     const Ray ray{Point3(1, 4, 1), Vector3(0, -1, 0)};  // crosses at t = 4
-    Ray clipped = ray;
-    clipped.t_max = std::nextafter(4.0, 0.0);
-    EXPECT_FALSE(kRectangle.intersect(clipped));
-    EXPECT_FALSE(kRectangle.occluded(clipped));
-    clipped.t_max = 4.0;
-    EXPECT_TRUE(kRectangle.intersect(clipped));
-    EXPECT_TRUE(kRectangle.occluded(clipped));
-    clipped = ray;
-    clipped.t_min = 4.0;
-    EXPECT_TRUE(kRectangle.intersect(clipped));
-    clipped.t_min = std::nextafter(4.0, 5.0);
-    EXPECT_FALSE(kRectangle.intersect(clipped));
-    EXPECT_FALSE(kRectangle.occluded(clipped));
+    test::expect_interval_honoured(kRectangle, ray, 4.0);
 }
 
 TEST(Rectangle, InvalidRaysNeverHit) {
-    const double nan = std::nan("");
-    for (const Ray& ray :
-         {Ray{Point3(nan, 4, 1), Vector3(0, -1, 0)}, Ray{Point3(1, 4, 1), Vector3(0, nan, 0)},
-          Ray{Point3(1, 4, 1), Vector3(0, 0, 0)}, Ray{Point3(1, kInfinity, 1), Vector3(0, -1, 0)},
-          Ray{Point3(1, 4, 1), Vector3(0, -kInfinity, 0)},
-          Ray{Point3(1, 4, 1), Vector3(0, -1, 0), nan, kInfinity},
-          Ray{Point3(1, 4, 1), Vector3(0, -1, 0), 5.0, 4.0}}) {
+    for (const Ray& ray : test::invalid_variants(Ray{Point3(1, 4, 1), Vector3(0, -1, 0)})) {
         EXPECT_FALSE(kRectangle.intersect(ray));
         EXPECT_FALSE(kRectangle.occluded(ray));
     }

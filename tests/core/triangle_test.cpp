@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "csgrt/core/error.h"
+#include "support/leaf_checks.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -159,34 +160,18 @@ TEST(Triangle, RayStartingOnTheTriangle) {
 
 TEST(Triangle, IntervalHonouredAtBothEnds) {
     const Ray ray{Point3(0.5, 0.5, 4), Vector3(0, 0, -1)};  // crosses at t = 4
+    test::expect_interval_honoured(kUnitTriangle, ray, 4.0);
     Ray clipped = ray;
-    clipped.t_max = std::nextafter(4.0, 0.0);
-    EXPECT_FALSE(kUnitTriangle.intersect(clipped));
-    EXPECT_FALSE(kUnitTriangle.occluded(clipped));
     clipped.t_max = 4.0;
     ASSERT_TRUE(kUnitTriangle.intersect(clipped));
     EXPECT_EQ(kUnitTriangle.intersect(clipped)->t, 4.0);
-    EXPECT_TRUE(kUnitTriangle.occluded(clipped));
-    clipped = ray;
-    clipped.t_min = 4.0;
-    EXPECT_TRUE(kUnitTriangle.intersect(clipped));
-    clipped.t_min = std::nextafter(4.0, 5.0);
-    EXPECT_FALSE(kUnitTriangle.intersect(clipped));
-    EXPECT_FALSE(kUnitTriangle.occluded(clipped));
     const Ray behind{Point3(0.5, 0.5, -3), Vector3(0, 0, -1), -kInfinity, 0.0};
     ASSERT_TRUE(kUnitTriangle.intersect(behind));
     EXPECT_EQ(kUnitTriangle.intersect(behind)->t, -3.0);
 }
 
 TEST(Triangle, InvalidRaysNeverHit) {
-    const double nan = std::nan("");
-    for (const Ray& ray :
-         {Ray{Point3(nan, 0.5, 4), Vector3(0, 0, -1)}, Ray{Point3(0.5, 0.5, 4), Vector3(0, 0, nan)},
-          Ray{Point3(0.5, 0.5, 4), Vector3(0, 0, 0)},
-          Ray{Point3(0.5, 0.5, kInfinity), Vector3(0, 0, -1)},
-          Ray{Point3(0.5, 0.5, 4), Vector3(0, 0, -kInfinity)},
-          Ray{Point3(0.5, 0.5, 4), Vector3(0, 0, -1), 0.0, nan},
-          Ray{Point3(0.5, 0.5, 4), Vector3(0, 0, -1), 5.0, 4.0}}) {
+    for (const Ray& ray : test::invalid_variants(Ray{Point3(0.5, 0.5, 4), Vector3(0, 0, -1)})) {
         EXPECT_FALSE(kUnitTriangle.intersect(ray));
         EXPECT_FALSE(kUnitTriangle.occluded(ray));
         HitRecord record;

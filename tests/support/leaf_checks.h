@@ -1,0 +1,58 @@
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "csgrt/core/ray.h"
+#include "csgrt/core/shape.h"
+
+namespace csgrt::test {
+
+/// Invalid versions of the valid ray `valid`: each origin and each direction component made NaN,
+/// +inf and -inf in turn, a zero direction, a NaN t_min, a NaN t_max, and t_min 5 above t_max
+/// 4. is_valid rejects each (checked here), so no query may report a hit.
+inline std::vector<Ray> invalid_variants(const Ray& valid) {
+    const double nan = std::nan("");
+    const Point3 o = valid.origin;
+    const Vector3 d = valid.direction;
+    std::vector<Ray> rays;
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const double bad : {nan, kInfinity, -kInfinity}) {
+            Ray origin{o, d};
+            origin.origin[axis] = bad;
+            rays.push_back(origin);
+            Ray direction{o, d};
+            direction.direction[axis] = bad;
+            rays.push_back(direction);
+        }
+    }
+    rays.push_back(Ray{o, Vector3(0, 0, 0)});
+    rays.push_back(Ray{o, d, nan, kInfinity});
+    rays.push_back(Ray{o, d, 0.0, nan});
+    rays.push_back(Ray{o, d, 5.0, 4.0});
+    for (const Ray& ray : rays) EXPECT_FALSE(is_valid(ray));
+    return rays;
+}
+
+/// The interval checks of a shape that `ray` crosses once, at t > 0: [.., t) misses, t_max = t
+/// and t_min = t hit, (t, ..] misses; occluded agrees with intersect at each.
+inline void expect_interval_honoured(const Shape& shape, const Ray& ray, double t) {
+    Ray clipped = ray;
+    clipped.t_max = std::nextafter(t, 0.0);
+    EXPECT_FALSE(shape.intersect(clipped));
+    EXPECT_FALSE(shape.occluded(clipped));
+    clipped.t_max = t;
+    EXPECT_TRUE(shape.intersect(clipped));
+    EXPECT_TRUE(shape.occluded(clipped));
+    clipped = ray;
+    clipped.t_min = t;
+    EXPECT_TRUE(shape.intersect(clipped));
+    EXPECT_TRUE(shape.occluded(clipped));
+    clipped.t_min = std::nextafter(t, 2.0 * t);
+    EXPECT_FALSE(shape.intersect(clipped));
+    EXPECT_FALSE(shape.occluded(clipped));
+}
+
+}  // namespace csgrt::test
