@@ -217,9 +217,11 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
         if (extension == ".stl") reader = &OpenMesh::IO::STLReader();
         // can_u_read also parses the header into the reader's options, which read() uses.
         if (!reader->can_u_read(name)) fail("OpenMesh's " + report.format + " reader refuses it");
-        // Vertex normals for PLY (nx ny nz); OBJ's are per corner and come from the scan.
+        // Vertex normals for PLY (nx ny nz) and OFF (NOFF: x y z nx ny nz); OBJ's are per
+        // corner and come from the scan.
         OpenMesh::IO::Options options;
-        if (extension == ".ply") options += OpenMesh::IO::Options::VertexNormal;
+        if (extension == ".ply" || extension == ".off")
+            options += OpenMesh::IO::Options::VertexNormal;
         if (!reader->read(name, importer, options)) fail("OpenMesh could not read it");
     }
     const std::size_t face_count = importer.face_count();
@@ -256,17 +258,17 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
     // distinct corners; the others must be OpenMesh's faces with their repeats put back.
     std::size_t written = 0;
     std::unordered_set<long long> seen;
-    // The file's normals: OBJ by corner (when every corner names one), PLY by vertex (when
-    // every vertex has one). A corner's normal in a triangle of an OBJ polygon is the one the
-    // polygon gave that vertex (the first, if it repeats).
+    // The file's normals: OBJ by corner (when every corner names one), PLY and NOFF by vertex
+    // (when every vertex has one). A corner's normal in a triangle of an OBJ polygon is the one
+    // the polygon gave that vertex (the first, if it repeats).
     const bool obj_normals =
         !expect.written_normals.empty() &&
         std::none_of(expect.written_normals.begin(), expect.written_normals.end(),
                      [](long long index) { return index < 0; });
-    const bool ply_normals = !importer.normal_set.empty() &&
-                             importer.normal_set.size() == importer.points.size() &&
-                             std::all_of(importer.normal_set.begin(), importer.normal_set.end(),
-                                         [](char set) { return set != 0; });
+    const bool normals_by_vertex =
+        !importer.normal_set.empty() && importer.normal_set.size() == importer.points.size() &&
+        std::all_of(importer.normal_set.begin(), importer.normal_set.end(),
+                    [](char set) { return set != 0; });
     std::vector<std::pair<std::uint32_t, long long>> normal_of;  // (vertex, normal), one face
     auto unit = [](const Eigen::Vector3f& n) {
         const float length = n.norm();
@@ -323,12 +325,12 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
         report.triangulated_faces += polygon.size() > 3 ? 1 : 0;
         const std::size_t first_triangle = mesh.triangles.size();
         if (!triangulate(polygon, mesh.vertices, mesh.triangles)) ++report.non_simple_faces;
-        if (!obj_normals && !ply_normals) continue;
+        if (!obj_normals && !normals_by_vertex) continue;
         for (std::size_t i = first_triangle; i < mesh.triangles.size(); ++i) {
             std::array<Eigen::Vector3f, 3> normals;
             for (int k = 0; k < 3; ++k) {
                 const std::uint32_t vertex = mesh.triangles[i][k];
-                if (ply_normals) {
+                if (normals_by_vertex) {
                     normals[k] = unit(importer.vertex_normals[vertex]);
                     continue;
                 }

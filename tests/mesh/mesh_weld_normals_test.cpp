@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -240,6 +242,7 @@ TEST(FileNormals, ObjCornerNormalsAreInterpolatedAndFollowAFlippedTriangle) {
     EXPECT_EQ(mesh->report().flipped_triangles, 1u);
     EXPECT_NE(describe(mesh->report()).find("normals from the file"), std::string::npos);
     int checked = 0, differ_from_computed = 0, flipped_face = 0;
+    long double max_error = 0;
     for (int r = 0; r < 600; ++r) {
         const Point3 origin = 3.0 * random.unit_vector();
         const Ray ray{origin, 0.3 * random.unit_vector() - origin};
@@ -259,17 +262,61 @@ TEST(FileNormals, ObjCornerNormalsAreInterpolatedAndFollowAFlippedTriangle) {
         };
         const auto expected = interpolated(*mesh, *hit, normal_at);
         // Float normals and barycentrics: a few 1e-7 (as for computed normals above).
-        EXPECT_NEAR((hit->shading_normal.cast<long double>() - expected).norm(), 0.0L, 1e-5L)
-            << "triangle " << f;
+        const long double error = (hit->shading_normal.cast<long double>() - expected).norm();
+        EXPECT_NEAR(error, 0.0L, 1e-5L) << "triangle " << f;
+        max_error = std::max(max_error, error);
         const std::optional<Hit> other = computed->intersect(ray);
         if (other && (other->shading_normal - hit->shading_normal).norm() > 1e-2)
             ++differ_from_computed;
         flipped_face += f == 5;
         ++checked;
     }
+    std::printf(
+        "[normals] OBJ by corner: %d hits (%d on the re-oriented face), max |shading - "
+        "interpolated| %.2Lg, %d shaded otherwise by computed normals\n",
+        checked, flipped_face, max_error, differ_from_computed);
     EXPECT_GT(checked, 400);
     EXPECT_GT(differ_from_computed, checked / 2);
     EXPECT_GT(flipped_face, 0);
+}
+
+/// Shading normals of `mesh` on `rays` random rays at it, against the per-vertex `normals`
+/// interpolated by the hit's barycentrics (to 1e-5: float normals and barycentrics); with
+/// `computed`, how many hits it shades differently (by > 1e-2), so the check can tell.
+struct NormalCheck {
+    int checked = 0;
+    int differ_from_computed = 0;
+    long double max_error = 0;
+};
+
+NormalCheck check_vertex_normals(const Mesh& mesh, const std::vector<Eigen::Vector3f>& normals,
+                                 const Mesh* computed, test::Random& random, int rays,
+                                 const std::string& label) {
+    NormalCheck check;
+    for (int r = 0; r < rays; ++r) {
+        const Point3 origin = 3.0 * random.unit_vector();
+        const Ray ray{origin, 0.3 * random.unit_vector() - origin};
+        const std::optional<Hit> hit = mesh.intersect(ray);
+        if (!hit) continue;
+        const auto& triangle = mesh.triangle(hit->primitive_id);
+        const auto expected = interpolated(
+            mesh, *hit, [&](int k) -> const Eigen::Vector3f& { return normals[triangle[k]]; });
+        const long double error = (hit->shading_normal.cast<long double>() - expected).norm();
+        EXPECT_NEAR(error, 0.0L, 1e-5L) << label;
+        check.max_error = std::max(check.max_error, error);
+        if (computed) {
+            const std::optional<Hit> other = computed->intersect(ray);
+            if (other && (other->shading_normal - hit->shading_normal).norm() > 1e-2)
+                ++check.differ_from_computed;
+        }
+        ++check.checked;
+    }
+    std::printf("[normals] %s: %d hits, max |shading - interpolated| %.2Lg", label.c_str(),
+                check.checked, check.max_error);
+    if (computed)
+        std::printf(", %d shaded otherwise by computed normals", check.differ_from_computed);
+    std::printf("\n");
+    return check;
 }
 
 TEST(FileNormals, PlyVertexNormalsAreInterpolatedAndPartialObjNormalsAreNotUsed) {
@@ -297,20 +344,8 @@ TEST(FileNormals, PlyVertexNormalsAreInterpolatedAndPartialObjNormalsAreNotUsed)
     const std::shared_ptr<Mesh> mesh = Mesh::load(ply);
     std::filesystem::remove(ply);
     EXPECT_TRUE(mesh->report().file_normals);
-    int checked = 0;
-    for (int r = 0; r < 300; ++r) {
-        const Point3 origin = 3.0 * random.unit_vector();
-        const Ray ray{origin, 0.3 * random.unit_vector() - origin};
-        const std::optional<Hit> hit = mesh->intersect(ray);
-        if (!hit) continue;
-        const auto& triangle = mesh->triangle(hit->primitive_id);
-        const auto expected = interpolated(*mesh, *hit, [&](int k) -> const Eigen::Vector3f& {
-            return vertex_normals[triangle[k]];
-        });
-        EXPECT_NEAR((hit->shading_normal.cast<long double>() - expected).norm(), 0.0L, 1e-5L);
-        ++checked;
-    }
-    EXPECT_GT(checked, 200);
+    EXPECT_GT(check_vertex_normals(*mesh, vertex_normals, nullptr, random, 300, "PLY").checked,
+              200);
 
     // An OBJ whose faces name normals for some corners only: the file's normals are not used
     // (the report says so) and shading is the computed vertex normals'.
@@ -340,6 +375,53 @@ TEST(FileNormals, PlyVertexNormalsAreInterpolatedAndPartialObjNormalsAreNotUsed)
         if (a) {
             EXPECT_NEAR((a->shading_normal - b->shading_normal).norm(), 0.0, 1e-5);
         }
+    }
+}
+
+TEST(FileNormals, NoffVertexNormalsAreUsedAsPlyOnes) {
+    // OFF with a normal after each vertex's coordinates ("NOFF"; "CNOFF" puts a colour after
+    // it): the same per-vertex normals as the PLY test above, interpolated by the barycentrics.
+    // The same file as plain OFF (the normals dropped) shades with computed normals, which
+    // differ from the file's on most hits, so the check can tell them apart.
+    const test::TestMesh sphere = test::sphere_mesh(1);
+    for (const bool coloured : {false, true}) {
+        test::Random random(29);
+        std::vector<Eigen::Vector3f> vertex_normals;
+        const std::filesystem::path noff = temporary_file("normals", ".off");
+        const std::filesystem::path off = temporary_file("no_normals", ".off");
+        {
+            std::ofstream with(noff), without(off);
+            with.precision(9);
+            without.precision(9);
+            with << (coloured ? "CNOFF\n" : "NOFF\n");
+            without << "OFF\n";
+            for (std::ofstream* out : {&with, &without})
+                *out << sphere.vertices.size() << " " << sphere.triangles.size() << " 0\n";
+            for (const Eigen::Vector3d& p : sphere.vertices) {
+                // Not unit length: the loader normalises them.
+                const Eigen::Vector3d n = 0.25 * (p + 0.5 * random.unit_vector()).normalized();
+                vertex_normals.push_back(n.cast<float>().normalized());
+                with << p.x() << " " << p.y() << " " << p.z() << " " << n.x() << " " << n.y() << " "
+                     << n.z() << (coloured ? " 0.5 0.25 1.0" : "") << "\n";
+                without << p.x() << " " << p.y() << " " << p.z() << "\n";
+            }
+            for (const auto& t : sphere.triangles) {
+                with << "3 " << t[0] << " " << t[1] << " " << t[2] << (coloured ? " 255 0 0" : "")
+                     << "\n";
+                without << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+            }
+        }
+        const std::shared_ptr<Mesh> mesh = Mesh::load(noff);
+        const std::shared_ptr<Mesh> plain = Mesh::load(off);
+        std::filesystem::remove(noff);
+        std::filesystem::remove(off);
+        EXPECT_TRUE(mesh->report().file_normals) << coloured;
+        EXPECT_TRUE(mesh->report().is_closed) << coloured;
+        EXPECT_FALSE(plain->report().file_normals);
+        const NormalCheck check = check_vertex_normals(*mesh, vertex_normals, plain.get(), random,
+                                                       300, coloured ? "CNOFF" : "NOFF");
+        EXPECT_GT(check.checked, 200);
+        EXPECT_GT(check.differ_from_computed, check.checked / 2);
     }
 }
 

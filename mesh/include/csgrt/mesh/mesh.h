@@ -39,7 +39,7 @@ struct MeshConfig {
     /// faces at its vertex within the angle of its own face, so edges sharper than the angle
     /// stay sharp. Pi (the default) joins every face (plain vertex normals).
     double crease_angle = kPi;
-    /// Shade with the normals the file stores (OBJ `vn`, PLY `nx ny nz`;
+    /// Shade with the normals the file stores (OBJ `vn`, PLY `nx ny nz`, NOFF's vertex normals;
     /// TriangleMeshData::corner_normals) when it has one for every corner, interpolated by the
     /// barycentrics like computed ones; they take the place of the crease angle. False
     /// computes normals as for a file without them.

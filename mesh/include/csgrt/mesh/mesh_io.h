@@ -31,9 +31,9 @@ struct TriangleMeshData {
     /// triangle uses or whose triangles' normals cancel. Filled by `validate_mesh` (and so by
     /// `load_mesh`).
     std::vector<Eigen::Vector3d> normals;
-    /// Normals the file stores (OBJ `vn` by face corner, PLY `nx ny nz` by vertex), one per
-    /// triangle corner in the order of `triangles`, unit or zero; empty when the file has none,
-    /// or not for every corner. A Mesh shades with them instead of `normals`
+    /// Normals the file stores (OBJ `vn` by face corner, PLY `nx ny nz` and NOFF by vertex),
+    /// one per triangle corner in the order of `triangles`, unit or zero; empty when the file
+    /// has none, or not for every corner. A Mesh shades with them instead of `normals`
     /// (MeshConfig::file_normals). validate_mesh keeps them with their triangles.
     std::vector<std::array<Eigen::Vector3f, 3>> corner_normals = {};
 };
