@@ -4,9 +4,12 @@
 #include <ostream>
 #include <sstream>
 #include <string>
+#include <unordered_set>
 #include <variant>
+#include <vector>
 
 #include "command_line_internal.h"
+#include "csgrt/mesh/mesh.h"
 
 namespace csgrt::command_line {
 
@@ -25,6 +28,40 @@ std::string describe(const Vector3& v) {
     return text.str();
 }
 
+/// A distinct mesh of the scene and the first top-level object it is under.
+struct SceneMesh {
+    const Mesh* mesh;
+    std::size_t object;
+};
+
+/// Every distinct Mesh in the trees under the scene's objects, in the order the objects list
+/// them; each shape is visited once, however often the trees share it.
+std::vector<SceneMesh> distinct_meshes(const Scene& scene) {
+    std::vector<SceneMesh> meshes;
+    std::unordered_set<const Shape*> seen;
+    std::vector<const Shape*> stack;
+    for (std::size_t i = 0; i < scene.objects().size(); ++i) {
+        stack.push_back(scene.objects()[i].shape.get());
+        while (!stack.empty()) {
+            const Shape* shape = stack.back();
+            stack.pop_back();
+            if (!seen.insert(shape).second) continue;
+            if (const auto* mesh = dynamic_cast<const Mesh*>(shape)) meshes.push_back({mesh, i});
+            for (const Shape* child : shape->children()) stack.push_back(child);
+        }
+    }
+    return meshes;
+}
+
+/// The object's name in quotes, or its index when it has none.
+std::string object_label(const Scene& scene, std::size_t object) {
+    const std::string& name = scene.objects()[object].name;
+    return name.empty() ? "object " + std::to_string(object) : '"' + name + '"';
+}
+
+/// The text report lists at most this many meshes one per line (a scene may hold many).
+constexpr std::size_t kMeshLines = 100;
+
 /// `csgrt info --json`: what the text report says, as one JSON object (docs/rendering.md).
 void print_info_json(const std::string& scene_path, const Scene& scene,
                      const std::map<std::string, std::uint64_t>& counts, std::uint64_t shapes,
@@ -42,6 +79,22 @@ void print_info_json(const std::string& scene_path, const Scene& scene,
     } else {
         camera_json["orthographic_height"] = camera.orthographic_height;
     }
+    nlohmann::json meshes = nlohmann::json::array();
+    for (const SceneMesh& entry : distinct_meshes(scene)) {
+        const MeshReport& report = entry.mesh->report();
+        meshes.push_back({{"object", entry.object},
+                          {"object_name", scene.objects()[entry.object].name},
+                          {"format", report.format},
+                          {"vertices", report.vertices},
+                          {"triangles", report.triangles},
+                          {"closed", report.is_closed},
+                          {"boundary_edges", report.boundary_edges},
+                          {"non_manifold_edges", report.non_manifold_edges},
+                          {"orientable", report.orientable},
+                          {"volume", report.volume},
+                          {"welded_vertices", report.welded_vertices},
+                          {"file_normals", report.file_normals}});
+    }
     const Aabb& bounds = scene.bounds();
     const nlohmann::json info = {
         {"scene", scene_path},
@@ -49,6 +102,7 @@ void print_info_json(const std::string& scene_path, const Scene& scene,
          {{"top_level", scene.objects().size()}, {"unbounded", unbounded}, {"shapes", shapes}}},
         {"kinds", counts},
         {"triangles", triangles},
+        {"meshes", meshes},
         {"materials", scene.materials().size()},
         {"lights",
          {{"total", scene.lights().size()},
@@ -96,6 +150,14 @@ void info_command(const std::string& scene_path, bool json, CommandLineStreams s
         out << "meshes:     " << counts.closed_meshes
             << " closed (solids: CSG operands, inside/outside), "
             << meshes->second - counts.closed_meshes << " open\n";
+        // Each distinct mesh, with what loading found: closed or why not (docs/meshes.md).
+        const std::vector<SceneMesh> distinct = distinct_meshes(scene);
+        for (std::size_t k = 0; k < distinct.size() && k < kMeshLines; ++k) {
+            out << "  " << object_label(scene, distinct[k].object) << ": "
+                << csgrt::describe(distinct[k].mesh->report()) << '\n';
+        }
+        if (distinct.size() > kMeshLines)
+            out << "  ... and " << distinct.size() - kMeshLines << " more meshes\n";
     }
     std::size_t point_lights = 0;
     for (const Light& light : scene.lights())

@@ -78,7 +78,8 @@ TEST_F(CommandLineJson, InfoIsOneObjectWithTheCountsOfTheTree) {
                                   {"plane", 1}, {"sphere", 3},     {"union", 1}};
     EXPECT_EQ(info["kinds"], kinds);
     EXPECT_EQ(info["triangles"], 0);
-    EXPECT_EQ(info["materials"], 2);  // "default" and "red"
+    EXPECT_EQ(info["meshes"], nlohmann::json::array());  // entries: command_line_test.cpp
+    EXPECT_EQ(info["materials"], 2);                     // "default" and "red"
     EXPECT_EQ(info["lights"]["point"], 1);
     EXPECT_EQ(info["lights"]["directional"], 1);
     EXPECT_EQ(info["camera"]["projection"], "pinhole");

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "csgrt/accel/factory.h"
 #include "csgrt/render/exr.h"
 
@@ -465,6 +467,79 @@ TEST_F(CommandLine, InfoReportsTheShowcasesMeshWithItsTriangleCount) {
                               " triangles in all)\n"),
               std::string::npos)
         << result.out;
+}
+
+TEST_F(CommandLine, InfoSaysForEachMeshWhetherItIsClosed) {
+    // A closed cube (six quads), the same cube with its top face missing, and the cube written
+    // one vertex per face corner (an open soup unless welded): each distinct mesh gets a line
+    // saying whether it is closed, and why not; the closed cube, used by two objects, once.
+    const std::string corners =
+        "-1 -1 -1\n1 -1 -1\n1 1 -1\n-1 1 -1\n-1 -1 1\n1 -1 1\n1 1 1\n-1 1 1\n";
+    const std::vector<std::string> quads = {"0 3 2 1", "4 5 6 7", "0 1 5 4",
+                                            "2 3 7 6", "1 2 6 5", "0 4 7 3"};
+    {
+        std::ofstream closed(directory_ / "cube.off"), open(directory_ / "open.off");
+        closed << "OFF\n8 6 0\n" << corners;
+        open << "OFF\n8 5 0\n" << corners;
+        for (std::size_t f = 0; f < quads.size(); ++f) {
+            closed << "4 " << quads[f] << "\n";
+            if (f != 3) open << "4 " << quads[f] << "\n";
+        }
+        std::ofstream soup(directory_ / "soup.off");
+        soup << "OFF\n24 6 0\n";
+        std::istringstream rows(corners);
+        std::vector<std::string> vertex(8);
+        for (std::string& v : vertex) std::getline(rows, v);
+        for (const std::string& quad : quads) {
+            std::istringstream indices(quad);
+            int index;
+            while (indices >> index) soup << vertex[static_cast<std::size_t>(index)] << "\n";
+        }
+        for (int f = 0; f < 6; ++f)
+            soup << "4 " << 4 * f << " " << 4 * f + 1 << " " << 4 * f + 2 << " " << 4 * f + 3
+                 << "\n";
+    }
+    std::ofstream(scene_, std::ios::trunc) << R"({"objects": [
+        {"type": "mesh", "path": "cube.off", "name": "cube"},
+        {"type": "mesh", "path": "open.off", "name": "open box"},
+        {"type": "mesh", "path": "cube.off", "transform": [{"translate": [3, 0, 0]}]},
+        {"type": "mesh", "path": "soup.off"},
+        {"type": "mesh", "path": "soup.off", "weld": true, "name": "welded"}]})";
+    const ProgramRun result = run({"info", scene_});
+    ASSERT_EQ(result.status, 0) << result.err;
+    for (const char* fragment :
+         {"meshes:     3 closed (solids: CSG operands, inside/outside), 2 open\n",
+          "  \"cube\": off, 8 vertices, 12 triangles from 6 faces (6 polygons triangulated), 1 "
+          "component, closed (volume 8)\n",
+          "  \"open box\": off, 8 vertices, 10 triangles from 5 faces (5 polygons triangulated), "
+          "1 component, open: 4 boundary and 0 non-manifold edges\n",
+          "  object 3: off, 24 vertices, 12 triangles from 6 faces (6 polygons triangulated), 6 "
+          "components, open: 24 boundary and 0 non-manifold edges\n",
+          "  \"welded\": off, 8 vertices, 12 triangles from 6 faces (6 polygons triangulated), 16 "
+          "vertices welded, 1 component, closed (volume 8)\n"}) {
+        EXPECT_NE(result.out.find(fragment), std::string::npos)
+            << "\"" << fragment << "\" not in:\n"
+            << result.out;
+    }
+    // Four distinct meshes, four lines: the cube used twice is listed once.
+    EXPECT_EQ(result.out.find("  object 2:"), std::string::npos) << result.out;
+
+    const ProgramRun json = run({"info", scene_, "--json"});
+    ASSERT_EQ(json.status, 0) << json.err;
+    const nlohmann::json meshes = nlohmann::json::parse(json.out)["meshes"];
+    ASSERT_EQ(meshes.size(), 4u) << meshes;
+    const std::size_t objects[] = {0, 1, 3, 4};
+    const bool closed[] = {true, false, false, true};
+    const std::size_t boundary[] = {0, 4, 24, 0}, welded[] = {0, 0, 0, 16};
+    for (std::size_t k = 0; k < 4; ++k) {
+        EXPECT_EQ(meshes[k]["object"], objects[k]) << meshes[k];
+        EXPECT_EQ(meshes[k]["closed"], closed[k]) << meshes[k];
+        EXPECT_EQ(meshes[k]["boundary_edges"], boundary[k]) << meshes[k];
+        EXPECT_EQ(meshes[k]["welded_vertices"], welded[k]) << meshes[k];
+        EXPECT_NEAR(meshes[k]["volume"].get<double>(), closed[k] ? 8.0 : 0.0, 1e-12) << meshes[k];
+    }
+    EXPECT_EQ(meshes[0]["object_name"], "cube");
+    EXPECT_EQ(meshes[3]["object_name"], "welded");
 }
 
 TEST_F(CommandLine, HelpAndVersionSucceed) {
