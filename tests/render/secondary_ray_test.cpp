@@ -14,14 +14,15 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
-#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/camera.h"
 #include "csgrt/csg/scene.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/render/renderer.h"
 #include "csgrt/render/shadow_offset.h"
 #include "support/meshes.h"
@@ -212,8 +213,9 @@ std::optional<bool> lit_with_former_offset(const Scene& scene, const Ray& ray) {
     return !scene.occluded(shadow, thread_query_scratch());
 }
 
-/// Thin gaps over a floor: a disk 0.05 above it, a sphere 0.01 above it, a slab 0.002 above
-/// it, lit by one point light, everything moved by `shift`.
+/// Thin gaps over a floor: a disk 0.05 above it, a sphere 0.01 above it, a block 0.002 above
+/// it (a quarter high, so that its shadow reaches out from under it where the camera sees it),
+/// lit by one point light, everything moved by `shift`.
 Scene thin_gaps(const Vector3& shift) {
     Scene scene;
     scene.add_object(std::make_shared<Box>(shift + Vector3(-4, -1, -4), shift + Vector3(4, 0, 4)),
@@ -224,8 +226,8 @@ Scene thin_gaps(const Vector3& shift) {
     scene.add_object(std::make_shared<Sphere>(shift + Vector3(0.6, 0.51, -0.4), 0.5), 0,
                      "sphere 0.01 above");
     scene.add_object(
-        std::make_shared<Box>(shift + Vector3(0.4, 0.002, 0.8), shift + Vector3(1.6, 0.012, 1.6)),
-        0, "slab 0.002 above");
+        std::make_shared<Box>(shift + Vector3(0.4, 0.002, 0.8), shift + Vector3(1.6, 0.252, 1.6)),
+        0, "block 0.002 above");
     // Low, so that shadows reach out from under their casters where the camera sees them.
     scene.add_light(PointLight{shift + Vector3(5.0, 1.5, 2.0), Vector3(100, 100, 100)});
     Camera camera;
@@ -254,6 +256,30 @@ TEST(SecondaryRays, AMovedSceneShadowsTheSamePixelsAndKeepsItsThinGaps) {
     // The three thin objects cast shadows on the floor at the origin (independently of any
     // offset: 0.002 is 10^9 of the point error there).
     ASSERT_GT(shadowed_floor, 100);
+    // Each of them: the first object a dark floor pixel's shadow ray meets. Moved scenes must
+    // shadow the same pixels (below), so each keeps its shadow at every translation.
+    std::array<long, 4> shadowed_by{};
+    const CameraFilm origin_film(at_origin.camera(), double(settings.width) / settings.height);
+    const Point3 light = std::get<PointLight>(at_origin.lights().front()).position;
+    for (int y = 0; y < settings.height; ++y) {
+        for (int x = 0; x < settings.width; ++x) {
+            const Pixel& p = reference.image.at(x, y);
+            if (!(p.object_id == 0 && p.alpha > 0.0f && p.red == 0.0f)) continue;
+            const Ray ray =
+                origin_film.ray((x + 0.5) / settings.width, (y + 0.5) / settings.height);
+            const std::optional<Hit> floor = at_origin.intersect(ray, thread_query_scratch());
+            ASSERT_TRUE(floor.has_value());
+            const Point3 origin = spawn_ray_origin(*floor, Normal3(0, 1, 0));
+            Ray shadow{origin, light - origin};
+            shadow.t_max = 1.0;
+            const std::optional<Hit> caster = at_origin.intersect(shadow, thread_query_scratch());
+            if (caster && caster->object_id < shadowed_by.size()) ++shadowed_by[caster->object_id];
+        }
+    }
+    std::printf("\n  dark floor pixels at the origin: %ld (disk %ld, sphere %ld, block %ld)\n",
+                shadowed_floor, shadowed_by[1], shadowed_by[2], shadowed_by[3]);
+    for (std::size_t caster = 1; caster < shadowed_by.size(); ++caster)
+        EXPECT_GT(shadowed_by[caster], 5) << "caster " << caster;
     std::printf(
         "\n  | translation | pixels whose lit/shadowed state differs from the origin's:"
         " former offset | point-error offset (renderer) |\n");
@@ -279,12 +305,13 @@ TEST(SecondaryRays, AMovedSceneShadowsTheSamePixelsAndKeepsItsThinGaps) {
     }
 }
 
-/// Long-double intervals of a line o + t d inside an axis-aligned box (empty: lo > hi), and
-/// the t where each slab is entered (to tell which face is crossed and whether two tie).
+/// The long-double interval of a line o + t d inside an axis-aligned box (empty: lo >= hi),
+/// the faces where it enters and leaves, and the next-latest entry and next-earliest exit (the
+/// line passes near an edge of the box where one of them nearly ties).
 struct BoxCrossing {
     long double lo = -1e4000L, hi = 1e4000L;
-    int axis = -1;
-    long double second_entry = -1e4000L;
+    int entry_axis = -1, exit_axis = -1;
+    long double second_entry = -1e4000L, second_exit = 1e4000L;
 };
 
 using Vec3L = Eigen::Matrix<long double, 3, 1>;
@@ -292,54 +319,117 @@ using Vec3L = Eigen::Matrix<long double, 3, 1>;
 BoxCrossing cross_box(const Vec3L& o, const Vec3L& d, const Vec3L& lower, const Vec3L& upper) {
     BoxCrossing c;
     for (int axis = 0; axis < 3; ++axis) {
+        if (d[axis] == 0.0L) {
+            if (o[axis] < lower[axis] || o[axis] > upper[axis]) c.lo = 1e4000L;
+            continue;
+        }
         long double t0 = (lower[axis] - o[axis]) / d[axis];
         long double t1 = (upper[axis] - o[axis]) / d[axis];
         if (t0 > t1) std::swap(t0, t1);
         if (t0 > c.lo) {
             c.second_entry = c.lo;
             c.lo = t0;
-            c.axis = axis;
+            c.entry_axis = axis;
         } else {
             c.second_entry = std::max(c.second_entry, t0);
         }
-        c.hi = std::min(c.hi, t1);
+        if (t1 < c.hi) {
+            c.second_exit = c.hi;
+            c.hi = t1;
+            c.exit_axis = axis;
+        } else {
+            c.second_exit = std::min(c.second_exit, t1);
+        }
     }
     return c;
 }
 
-/// The cavity scene: a box with a spherical dish cut into its top face, a point light just
-/// above the rim, so that light grazes the dish and the top face, and the rim shadows part of
-/// the dish.
+/// A cavity scene: a block with a cavity cut into its top face (a ball, a spherical dish, or a
+/// box, a flat-floored pocket), a point light just above the top face so that light grazes the
+/// cavity and the rim shadows part of it, and a camera looking into it.
 struct Cavity {
+    const char* name;
     Vec3L lower{-2.0L, -1.0L, -2.0L}, upper{2.0L, 0.0L, 2.0L};
-    Vec3L centre{0.0L, 0.5L, 0.0L};
-    long double radius = 1.2L;
-    Point3 light{-1.3, 0.05, 0.1};
+    /// The cut: a ball (radius > 0) or else the box [cut_lower, cut_upper].
+    Vec3L centre{0.0L, 0.0L, 0.0L};
+    long double radius = 0.0L;
+    Vec3L cut_lower{0.0L, 0.0L, 0.0L}, cut_upper{0.0L, 0.0L, 0.0L};
+    Point3 light{0.0, 0.0, 0.0};
+    Point3 eye{0.0, 0.0, 0.0}, look_at{0.0, 0.0, 0.0};
+    double fov_degrees = 50.0;
 
-    /// The intervals of the line o + t d inside box minus ball, at most two, and the events.
+    std::shared_ptr<const Shape> shape(const Vector3& shift) const {
+        auto block =
+            std::make_shared<Box>(shift + lower.cast<double>(), shift + upper.cast<double>());
+        std::shared_ptr<const Shape> cut;
+        if (radius > 0.0L) {
+            cut = std::make_shared<Sphere>(shift + centre.cast<double>(), double(radius));
+        } else {
+            cut = std::make_shared<Box>(shift + cut_lower.cast<double>(),
+                                        shift + cut_upper.cast<double>());
+        }
+        return make_difference(block, {cut});
+    }
+
+    /// The intervals of the line o + t d inside the block minus the cut, at most two, and the
+    /// events near which the double computation may decide either way.
     struct Along {
         std::vector<std::array<long double, 2>> inside;
         std::vector<long double> events;
     };
     Along along(const Vec3L& o, const Vec3L& d) const {
         Along result;
-        const BoxCrossing box = cross_box(o, d, lower, upper);
-        if (!(box.lo < box.hi)) return result;
-        const Vec3L f = o - centre;
-        const long double a = d.squaredNorm(), b = f.dot(d), c = f.squaredNorm() - radius * radius;
-        const long double disc = b * b - a * c;
-        result.events = {box.lo, box.hi, box.second_entry};
-        if (disc <= 0.0L) {
-            result.inside.push_back({box.lo, box.hi});
+        const BoxCrossing block = cross_box(o, d, lower, upper);
+        if (!(block.lo < block.hi)) return result;
+        result.events = {block.lo, block.hi, block.second_entry, block.second_exit};
+        long double t0 = 0.0L, t1 = 0.0L;
+        bool cut = false;
+        if (radius > 0.0L) {
+            const Vec3L f = o - centre;
+            const long double a = d.squaredNorm(), b = f.dot(d);
+            const long double disc = b * b - a * (f.squaredNorm() - radius * radius);
+            if (disc > 0.0L) {
+                const long double root = std::sqrt(disc);
+                t0 = (-b - root) / a;
+                t1 = (-b + root) / a;
+                cut = true;
+                result.events.insert(result.events.end(), {t0, t1});
+            }
+        } else {
+            const BoxCrossing box = cross_box(o, d, cut_lower, cut_upper);
+            if (box.lo < box.hi) {
+                t0 = box.lo;
+                t1 = box.hi;
+                cut = true;
+                result.events.insert(result.events.end(),
+                                     {box.lo, box.hi, box.second_entry, box.second_exit});
+            }
+        }
+        if (!cut) {
+            result.inside.push_back({block.lo, block.hi});
             return result;
         }
-        const long double root = std::sqrt(disc);
-        const long double t0 = (-b - root) / a, t1 = (-b + root) / a;
-        result.events.push_back(t0);
-        result.events.push_back(t1);
-        if (box.lo < std::min(t0, box.hi)) result.inside.push_back({box.lo, std::min(t0, box.hi)});
-        if (std::max(t1, box.lo) < box.hi) result.inside.push_back({std::max(t1, box.lo), box.hi});
+        if (block.lo < std::min(t0, block.hi))
+            result.inside.push_back({block.lo, std::min(t0, block.hi)});
+        if (std::max(t1, block.lo) < block.hi)
+            result.inside.push_back({std::max(t1, block.lo), block.hi});
         return result;
+    }
+
+    /// The normal facing the air at the first hit t of the line o + t d.
+    Vec3L normal(const Vec3L& o, const Vec3L& d, long double t) const {
+        const BoxCrossing block = cross_box(o, d, lower, upper);
+        Vec3L n = Vec3L::Zero();
+        if (t == block.lo) {
+            n[block.entry_axis] = d[block.entry_axis] > 0.0L ? -1.0L : 1.0L;
+        } else if (radius > 0.0L) {
+            n = (centre - (o + t * d)) / radius;  // the dish faces into the ball
+        } else {
+            // The cut box's face where the line leaves it: it faces back into the pocket.
+            const BoxCrossing box = cross_box(o, d, cut_lower, cut_upper);
+            n[box.exit_axis] = d[box.exit_axis] > 0.0L ? -1.0L : 1.0L;
+        }
+        return n;
     }
 };
 
@@ -360,14 +450,7 @@ Verdict reference_verdict(const Cavity& cavity, const Ray& ray) {
         }
     }
     const Vec3L p = o + t * d;
-    Vec3L n;
-    const BoxCrossing box = cross_box(o, d, cavity.lower, cavity.upper);
-    if (t == box.lo) {
-        n = Vec3L::Zero();
-        n[box.axis] = d[box.axis] > 0.0L ? -1.0L : 1.0L;
-    } else {
-        n = (cavity.centre - p) / cavity.radius;  // the dish faces into the ball
-    }
+    const Vec3L n = cavity.normal(o, d, t);
     const Vec3L l = cavity.light.cast<long double>() - p;
     const long double cosine = n.dot(l) / l.norm();
     if (std::abs(cosine) < band) return Verdict::kAmbiguous;
@@ -383,65 +466,106 @@ Verdict reference_verdict(const Cavity& cavity, const Ray& ray) {
     return verdict;
 }
 
-TEST(SecondaryRays, GrazingLightInAConcaveCavityMatchesALongDoubleReference) {
-    const Cavity cavity;
+/// The cavities. The dish: a ball cut from the block, the light 0.05 above the rim, seen
+/// whole. The same dish with the light just inside the tangent plane of its near rim
+/// (0.40 high at x = -1.3, where the plane is 0.456 high), seen closely where the rim's shadow
+/// ends on the near wall: the light grazes the concave wall there. The pocket: a box 0.02 deep,
+/// the light 0.0025 above the top face 0.3 beyond the rim, so that the rim's shadow falls on
+/// the floor at x = 0.9, where the light rises 1/120 above the floor. Grazing light multiplies
+/// a shadow ray's offset along the normal: leaving a distance e above the floor, it clears the
+/// rim as if the rim were 120 e further away, so the former offset (2^-16 of the point's largest
+/// coordinate, 1.5e-5 here) moves the shadow's edge by 1.8e-3, about a pixel of the camera
+/// looking at that edge. Near the origin; only the offset decides.
+std::vector<Cavity> cavities() {
+    Cavity dish{"dish"};
+    dish.centre = Vec3L(0.0L, 0.5L, 0.0L);
+    dish.radius = 1.2L;
+    dish.light = Point3(-1.3, 0.05, 0.1);
+    dish.eye = Point3(0.9, 3.0, 1.6);
+    dish.look_at = Point3(-0.2, -0.3, 0.0);
+    dish.fov_degrees = 50.0;
+    Cavity wall = dish;
+    wall.name = "dish, light grazing its near wall";
+    wall.light = Point3(-1.3, 0.40, 0.1);
+    wall.eye = Point3(0.6, 1.5, 0.3);
+    wall.look_at = Point3(-1.02, -0.12, 0.0);
+    wall.fov_degrees = 2.0;
+    Cavity pocket{"pocket"};
+    pocket.cut_lower = Vec3L(-1.5L, -0.02L, -1.5L);
+    pocket.cut_upper = Vec3L(1.5L, 1.0L, 1.5L);
+    pocket.light = Point3(-1.8, 0.0025, 0.2);
+    // Above the shadow's edge, off its line, so the edge crosses the image diagonally.
+    pocket.look_at = Point3(0.9, -0.02, 1.0);
+    pocket.eye = pocket.look_at + Vector3(0.35, 0.5, 0.25);
+    pocket.fov_degrees = 8.0;
+    return {dish, wall, pocket};
+}
+
+TEST(SecondaryRays, GrazingLightInConcaveCavitiesMatchesALongDoubleReference) {
     RenderSettings settings;
     settings.width = 48;
     settings.height = 48;
     settings.threads = 1;
     std::printf(
-        "\n  | translation | pixels | lit | dark | ambiguous (within 1e-9) |"
+        "\n  | cavity | translation | pixels | lit | dark | ambiguous (within 1e-9) |"
         " disagreements: former offset | point-error offset (renderer) |\n");
-    for (const double translation : {0.0, 1e4}) {
-        // The reference is computed for the scene at the origin with the moved scene's rays
-        // moved back: the same geometry, exactly.
-        const Vector3 shift = translation * kShiftDirection;
-        Scene scene;
-        auto box = std::make_shared<Box>(shift + cavity.lower.cast<double>(),
-                                         shift + cavity.upper.cast<double>());
-        auto ball =
-            std::make_shared<Sphere>(shift + cavity.centre.cast<double>(), double(cavity.radius));
-        scene.add_object(make_difference(box, {ball}), 0, "dish");
-        scene.add_light(PointLight{shift + cavity.light, Vector3(10, 10, 10)});
-        Camera camera;
-        camera.position = shift + Vector3(0.9, 3.0, 1.6);
-        camera.look_at = shift + Vector3(-0.2, -0.3, 0.0);
-        camera.vertical_fov_degrees = 50.0;
-        scene.set_camera(camera);
-        scene.commit();
-        const RenderResult result = render(scene, settings);
-        const CameraFilm film(scene.camera(), 1.0);
-        long lit = 0, dark = 0, ambiguous = 0, wrong = 0, wrong_before = 0;
-        for (int y = 0; y < settings.height; ++y) {
-            for (int x = 0; x < settings.width; ++x) {
-                const Ray ray = film.ray((x + 0.5) / settings.width, (y + 0.5) / settings.height);
-                // Moving the origin back by `shift` rounds it; at 10^4 that is 2^-40 and far
-                // inside the ambiguity band.
-                const Ray at_origin{ray.origin - shift, ray.direction};
-                const Verdict verdict = reference_verdict(cavity, at_origin);
-                const Pixel& pixel = result.image.at(x, y);
-                if (verdict == Verdict::kAmbiguous) {
-                    ++ambiguous;
-                    continue;
+    for (const Cavity& cavity : cavities()) {
+        for (const double translation : {0.0, 1e4}) {
+            // The reference is computed for the scene at the origin with the moved scene's rays
+            // moved back: the same geometry, exactly.
+            const Vector3 shift = translation * kShiftDirection;
+            Scene scene;
+            scene.add_object(cavity.shape(shift), 0, cavity.name);
+            scene.add_light(PointLight{shift + cavity.light, Vector3(10, 10, 10)});
+            Camera camera;
+            camera.position = shift + cavity.eye;
+            camera.look_at = shift + cavity.look_at;
+            camera.vertical_fov_degrees = cavity.fov_degrees;
+            scene.set_camera(camera);
+            scene.commit();
+            const RenderResult result = render(scene, settings);
+            const CameraFilm film(scene.camera(), 1.0);
+            long lit = 0, dark = 0, ambiguous = 0, wrong = 0, wrong_before = 0;
+            for (int y = 0; y < settings.height; ++y) {
+                for (int x = 0; x < settings.width; ++x) {
+                    const Ray ray =
+                        film.ray((x + 0.5) / settings.width, (y + 0.5) / settings.height);
+                    // Moving the origin back by `shift` rounds it; at 10^4 that is 2^-40 and
+                    // far inside the ambiguity band.
+                    const Ray at_origin{ray.origin - shift, ray.direction};
+                    const Verdict verdict = reference_verdict(cavity, at_origin);
+                    const Pixel& pixel = result.image.at(x, y);
+                    if (verdict == Verdict::kAmbiguous) {
+                        ++ambiguous;
+                        continue;
+                    }
+                    ASSERT_EQ(pixel.alpha > 0.0f, verdict != Verdict::kMiss)
+                        << cavity.name << " " << x << ", " << y;
+                    if (verdict == Verdict::kMiss) continue;
+                    const bool expected_lit = verdict == Verdict::kLit;
+                    (expected_lit ? lit : dark) += 1;
+                    if ((pixel.red > 0.0f) != expected_lit) {
+                        ++wrong;
+                        ADD_FAILURE()
+                            << cavity.name << " pixel " << x << ", " << y << " at translation "
+                            << translation << ": expected " << (expected_lit ? "lit" : "dark");
+                    }
+                    const std::optional<bool> before = lit_with_former_offset(scene, ray);
+                    if (before.has_value() && *before != expected_lit) ++wrong_before;
                 }
-                ASSERT_EQ(pixel.alpha > 0.0f, verdict != Verdict::kMiss) << x << ", " << y;
-                if (verdict == Verdict::kMiss) continue;
-                const bool expected_lit = verdict == Verdict::kLit;
-                (expected_lit ? lit : dark) += 1;
-                if ((pixel.red > 0.0f) != expected_lit) {
-                    ++wrong;
-                    ADD_FAILURE() << "pixel " << x << ", " << y << " at translation " << translation
-                                  << ": expected " << (expected_lit ? "lit" : "dark");
-                }
-                const std::optional<bool> before = lit_with_former_offset(scene, ray);
-                if (before.has_value() && *before != expected_lit) ++wrong_before;
+            }
+            std::printf("  | %s | %g | %d | %ld | %ld | %ld | %ld | %ld |\n", cavity.name,
+                        translation, settings.width * settings.height, lit, dark, ambiguous,
+                        wrong_before, wrong);
+            // Light must graze: both verdicts occur in the cavity.
+            EXPECT_GT(lit, 200) << cavity.name;
+            EXPECT_GT(dark, 100) << cavity.name;
+            // The control: with grazing light the former offset gets shadow edges wrong even
+            // at the origin (and everything far from it), so this test fails with it.
+            if (std::string_view(cavity.name) != "dish" || translation > 0.0) {
+                EXPECT_GT(wrong_before, 0) << cavity.name << " at " << translation;
             }
         }
-        std::printf("  | %g | %d | %ld | %ld | %ld | %ld | %ld |\n", translation,
-                    settings.width * settings.height, lit, dark, ambiguous, wrong_before, wrong);
-        // Light must graze: both verdicts occur on the dish.
-        EXPECT_GT(lit, 200);
-        EXPECT_GT(dark, 100);
     }
 }
 
