@@ -320,25 +320,15 @@ Tally judge(const ReferenceResult& reference, const std::vector<Ray>& rays,
 }
 
 /// The operands' vertex coordinates along each axis, sorted, without repeats.
-using AxisCoordinates = std::array<std::vector<double>, 3>;
-
-AxisCoordinates vertex_coordinates(const Operand& first, const Operand& second) {
-    AxisCoordinates values;
-    for (const Operand* operand : {&first, &second}) {
-        for (const Eigen::Vector3d& p : operand->inner.vertices) {
-            for (int axis = 0; axis < 3; ++axis) values[axis].push_back(p[axis]);
-        }
-    }
-    for (std::vector<double>& axis : values) {
-        std::sort(axis.begin(), axis.end());
-        axis.erase(std::unique(axis.begin(), axis.end()), axis.end());
-    }
-    return values;
+test::AxisCoordinates vertex_coordinates(const Operand& first, const Operand& second) {
+    std::vector<Eigen::Vector3d> points = first.inner.vertices;
+    points.insert(points.end(), second.inner.vertices.begin(), second.inner.vertices.end());
+    return test::axis_coordinates(points);
 }
 
 /// Camera-like rays at the case's box, and axis-parallel rays: a third at random, a third in a
 /// plane through operand vertices (along faces), a third on a line through them (along edges).
-std::vector<Ray> case_rays(const Aabb& box, const AxisCoordinates& coordinates, int camera,
+std::vector<Ray> case_rays(const Aabb& box, const test::AxisCoordinates& coordinates, int camera,
                            int axis_rays, std::uint64_t seed) {
     std::vector<Ray> rays;
     test::Random random(seed);
@@ -348,23 +338,7 @@ std::vector<Ray> case_rays(const Aabb& box, const AxisCoordinates& coordinates, 
         const Point3 target = random.in_box(box);
         rays.push_back(Ray{eye, (target - eye) / size});
     }
-    auto pick = [&](int axis) {
-        const std::vector<double>& values = coordinates[static_cast<std::size_t>(axis)];
-        return values[static_cast<std::size_t>(
-            random.integer(0, static_cast<int>(values.size()) - 1))];
-    };
-    for (int i = 0; i < axis_rays; ++i) {
-        const int along = i % 3;
-        const double sign = (i / 3) % 2 == 0 ? 1.0 : -1.0;
-        Point3 origin = random.in_box(box);
-        const int first = (along + 1) % 3, second = (along + 2) % 3;
-        if ((i / 6) % 3 != 0) origin[first] = pick(first);
-        if ((i / 6) % 3 == 2) origin[second] = pick(second);
-        origin[along] = sign > 0 ? box.lower[along] - size : box.upper[along] + size;
-        Vector3 direction = Vector3::Zero();
-        direction[along] = sign;
-        rays.push_back(Ray{origin, direction});
-    }
+    test::append_rays_along_faces_and_edges(random, box, coordinates, axis_rays, rays);
     return rays;
 }
 

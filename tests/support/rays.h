@@ -3,6 +3,8 @@
 // Seeded ray sets shared by the structure tests: camera-like, incoherent and axis-parallel
 // rays around a scene's box.
 
+#include <algorithm>
+#include <array>
 #include <vector>
 
 #include "csgrt/core/aabb.h"
@@ -92,6 +94,49 @@ inline std::vector<Ray> axis_rays(const Aabb& box, int count, std::uint64_t seed
         rays.push_back(Ray{random.in_box(around), direction});
     }
     return rays;
+}
+
+/// Each axis's coordinates of `points`, sorted, without repeats: the planes and lines an axis
+/// ray must lie in to run along a mesh's axis-aligned faces and edges.
+using AxisCoordinates = std::array<std::vector<double>, 3>;
+
+inline AxisCoordinates axis_coordinates(const std::vector<Eigen::Vector3d>& points) {
+    AxisCoordinates values;
+    for (const Eigen::Vector3d& p : points) {
+        for (int axis = 0; axis < 3; ++axis) values[axis].push_back(p[axis]);
+    }
+    for (std::vector<double>& axis : values) {
+        std::sort(axis.begin(), axis.end());
+        axis.erase(std::unique(axis.begin(), axis.end()), axis.end());
+    }
+    return values;
+}
+
+/// Appends `count` rays parallel to the axes (direction exactly +-1 along one), starting a box
+/// size beyond `box` and crossing it: a third through random points, a third in a plane through
+/// a vertex coordinate (along faces: the rays CGAL's in-plane case answers), a third on a line
+/// through two (along edges, through vertices).
+inline void append_rays_along_faces_and_edges(Random& random, const Aabb& box,
+                                              const AxisCoordinates& coordinates, int count,
+                                              std::vector<Ray>& rays) {
+    const double size = box.diagonal().norm();
+    auto pick = [&](int axis) {
+        const std::vector<double>& values = coordinates[static_cast<std::size_t>(axis)];
+        return values[static_cast<std::size_t>(
+            random.integer(0, static_cast<int>(values.size()) - 1))];
+    };
+    for (int i = 0; i < count; ++i) {
+        const int along = i % 3;
+        const double sign = (i / 3) % 2 == 0 ? 1.0 : -1.0;
+        Point3 origin = random.in_box(box);
+        const int first = (along + 1) % 3, second = (along + 2) % 3;
+        if ((i / 6) % 3 != 0) origin[first] = pick(first);
+        if ((i / 6) % 3 == 2) origin[second] = pick(second);
+        origin[along] = sign > 0 ? box.lower[along] - size : box.upper[along] + size;
+        Vector3 direction = Vector3::Zero();
+        direction[along] = sign;
+        rays.push_back(Ray{origin, direction});
+    }
 }
 
 }  // namespace csgrt::test
