@@ -4,7 +4,7 @@
 #include "csgrt/csg/scene_file.h"
 
 #include <fstream>
-#include <sstream>
+#include <string>
 
 #include "scene_file/limits.h"
 #include "scene_file/loader.h"
@@ -58,10 +58,22 @@ Scene load_scene(const std::filesystem::path& path) {
     }
     std::ifstream file(path, std::ios::binary);
     if (!file) throw SceneError(path.string() + ": cannot open the scene file");
-    std::ostringstream text;
-    text << file.rdbuf();
-    if (!file.good() && !file.eof()) throw SceneError(path.string() + ": cannot read the file");
-    return load(text.str(), Source{path.string(), path.parent_path()});
+    // Read up to the cap and one byte more, whatever the size said: a file still being
+    // written grows after its size was taken.
+    std::string text(static_cast<std::size_t>(size), '\0');
+    file.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(file.gcount()));
+    for (char buffer[1 << 16]; file.read(buffer, sizeof buffer) || file.gcount() > 0;) {
+        text.append(buffer, static_cast<std::size_t>(file.gcount()));
+        if (text.size() > kMaxSceneFileBytes) {
+            throw SceneError(path.string() + ": the file grew past " +
+                             std::to_string(kMaxSceneFileBytes) +
+                             " bytes while it was read; scene files are at most that (256 MiB; "
+                             "docs/scene-format.md, Limits)");
+        }
+    }
+    if (file.bad()) throw SceneError(path.string() + ": cannot read the file");
+    return load(text, Source{path.string(), path.parent_path()});
 }
 
 Scene load_scene_from_string(std::string_view text, const std::string& name,

@@ -83,17 +83,16 @@ std::vector<Copy> Loader::copies(Fields& fields, bool top_level) {
         // one leaves them to the materials around them.
         palette.push_back(material_named(fields, "material", fields.string("material", "default")));
     } else if (!given.empty()) {
-        const std::string at = fields.pointer(given);
+        const JsonPointer at = fields.pointer(given);
         const Json& names = fields.array(given, ramp ? 2 : 1, "material names");
         for (std::size_t m = 0; m < names.size(); ++m) {
             if (!names[m].is_string()) {
-                source_.fail(child_pointer(at, m),
-                             "expected a material name, got " + describe(names[m]));
+                source_.fail(at.child(m), "expected a material name, got " + describe(names[m]));
             }
             palette.push_back(material_named(fields, given, names[m].get<std::string>()));
             if (ramp && scene_->materials()[palette.back()].ior !=
                             scene_->materials()[palette.front()].ior) {
-                source_.fail(child_pointer(at, m),
+                source_.fail(at.child(m),
                              "expected materials of one index of refraction (\"ior\") in a "
                              "ramp: glass does not blend into paint");
             }
@@ -146,7 +145,9 @@ std::vector<Copy> Loader::grid(Fields& fields) {
     std::size_t counts[3];
     std::size_t total = 1;
     for (int axis = 0; axis < 3; ++axis) {
-        counts[axis] = fields.to_count(count[axis], child_pointer(fields.pointer("count"), axis));
+        counts[axis] = fields.to_count(count[axis], [&] {
+            return fields.pointer("count").child(static_cast<std::size_t>(axis));
+        });
         if (counts[axis] == 0) {
             fields.fail("count",
                         "expected every count >= 1, got 0 at index " + std::to_string(axis));
@@ -190,6 +191,8 @@ std::vector<Copy> Loader::grid(Fields& fields) {
             transform(fields.array("transform", 0, "transforms"), fields.pointer("transform"));
     }
     // Copies in x-fastest order, centred on the origin, then the grid's own transform.
+    const JsonPointer stepped_at = fields.pointer("copy_transform");
+    const JsonPointer placed_at = stepped ? stepped_at : fields.pointer("transform");
     std::vector<Copy> made;
     made.reserve(total);
     Transform turned;
@@ -199,7 +202,7 @@ std::vector<Copy> Loader::grid(Fields& fields) {
             for (cell[0] = 0; cell[0] < counts[0]; ++cell[0]) {
                 if (stepped && !made.empty()) {
                     turned = step * turned;
-                    require_representable(turned, source_, fields.pointer("copy_transform"), true);
+                    require_representable(turned, source_, stepped_at, true);
                 }
                 const Vector3 offset = cell_offset(counts, cell, spacing);
                 if (!offset.allFinite()) {
@@ -212,9 +215,7 @@ std::vector<Copy> Loader::grid(Fields& fields) {
                 }
                 const Transform world_from_copy = placement * Transform::translate(offset) * turned;
                 if (stepped || !placement.is_identity()) {
-                    require_representable(world_from_copy, source_,
-                                          fields.pointer(stepped ? "copy_transform" : "transform"),
-                                          true);
+                    require_representable(world_from_copy, source_, placed_at, true);
                 }
                 made.push_back(Copy{place(item, world_from_copy)});
             }
@@ -239,8 +240,9 @@ std::vector<Copy> Loader::array(Fields& fields) {
     }
     std::vector<Copy> made;
     made.reserve(list.size());
+    const JsonPointer copies_at = fields.pointer("copies");
     for (std::size_t c = 0; c < list.size(); ++c) {
-        Fields entry(list[c], child_pointer(fields.pointer("copies"), c), source_, "a copy");
+        Fields entry(list[c], copies_at.child(c), source_, "a copy");
         Transform world_from_copy = placement;
         if (entry.has("transform")) {
             world_from_copy = placement * transform(entry.array("transform", 0, "transforms"),

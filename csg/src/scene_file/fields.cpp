@@ -2,7 +2,7 @@
 
 namespace csgrt::detail::scene_file {
 
-Fields::Fields(const Json& value, std::string pointer, const Source& source, std::string_view what)
+Fields::Fields(const Json& value, JsonPointer pointer, const Source& source, std::string_view what)
     : value_(value), pointer_(std::move(pointer)), source_(source), what_(what) {
     if (!value_.is_object()) {
         source_.fail(pointer_, "expected an object (" + what_ + "), got " + describe(value_));
@@ -35,8 +35,9 @@ std::string Fields::string(std::string_view key) {
 Vector3 Fields::colour(std::string_view key, const Vector3& fallback) {
     if (!has(key)) return fallback;
     const Json& value = value_.at(key);
-    if (value.is_number()) return Vector3::Constant(to_number(value, pointer(key)));
-    return to_vector(value, pointer(key));
+    const auto at = [&] { return pointer(key); };
+    if (value.is_number()) return Vector3::Constant(to_number(value, at));
+    return to_vector(value, at);
 }
 
 const Json& Fields::array(std::string_view key, std::size_t minimum, std::string_view of) {
@@ -64,30 +65,6 @@ void Fields::finish() const {
         for (const std::string& key : asked_) known += (known.empty() ? "" : ", ") + key;
         source_.fail(pointer(it.key()), message + "; expected one of: " + known);
     }
-}
-
-double Fields::to_number(const Json& value, const std::string& at) const {
-    if (!value.is_number()) source_.fail(at, "expected a number, got " + describe(value));
-    const double number = value.get<double>();
-    // JSON has no NaN or infinity, but a literal like 1e999 overflows to infinity.
-    if (!std::isfinite(number)) source_.fail(at, "expected a finite number, got " + value.dump());
-    return number;
-}
-
-std::size_t Fields::to_count(const Json& value, const std::string& at) const {
-    if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
-        source_.fail(at, "expected a whole number >= 0, got " + describe(value));
-    }
-    return value.get<std::size_t>();
-}
-
-Vector3 Fields::to_vector(const Json& value, const std::string& at) const {
-    if (!value.is_array() || value.size() != 3) {
-        source_.fail(at, "expected an array of 3 numbers, got " + describe(value));
-    }
-    return Vector3(to_number(value[0], child_pointer(at, 0)),
-                   to_number(value[1], child_pointer(at, 1)),
-                   to_number(value[2], child_pointer(at, 2)));
 }
 
 }  // namespace csgrt::detail::scene_file

@@ -4,7 +4,9 @@
 // at their keys, each checked with a message at its JSON pointer, and unknown keys refused.
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,11 +20,11 @@ namespace csgrt::detail::scene_file {
 /// `finish` can reject the keys nobody asked for and list the ones that are known.
 class Fields {
 public:
-    Fields(const Json& value, std::string pointer, const Source& source, std::string_view what);
+    Fields(const Json& value, JsonPointer pointer, const Source& source, std::string_view what);
 
     const Json& value() const { return value_; }
-    const std::string& pointer() const { return pointer_; }
-    std::string pointer(std::string_view key) const { return child_pointer(pointer_, key); }
+    const JsonPointer& pointer() const { return pointer_; }
+    JsonPointer pointer(std::string_view key) const { return pointer_.child(key); }
     const Source& source() const { return source_; }
     const std::string& what() const { return what_; }
     void set_what(std::string what) { what_ = std::move(what); }
@@ -40,7 +42,7 @@ public:
     const Json& required(std::string_view key, std::string_view expected);
 
     double number(std::string_view key) {
-        return to_number(required(key, "a number"), pointer(key));
+        return to_number(required(key, "a number"), [&] { return pointer(key); });
     }
     double number(std::string_view key, double fallback) {
         return has(key) ? number(key) : fallback;
@@ -51,7 +53,7 @@ public:
     }
 
     std::size_t count(std::string_view key) {
-        return to_count(required(key, "a whole number"), pointer(key));
+        return to_count(required(key, "a whole number"), [&] { return pointer(key); });
     }
 
     bool boolean(std::string_view key, bool fallback);
@@ -62,7 +64,7 @@ public:
     }
 
     Vector3 vector(std::string_view key) {
-        return to_vector(required(key, "an array of 3 numbers"), pointer(key));
+        return to_vector(required(key, "an array of 3 numbers"), [&] { return pointer(key); });
     }
     Vector3 vector(std::string_view key, const Vector3& fallback) {
         return has(key) ? vector(key) : fallback;
@@ -80,12 +82,52 @@ public:
         source_.fail(key.empty() ? pointer_ : pointer(key), message);
     }
 
+    // The conversions take where the value is either as a JsonPointer or as a function that
+    // makes one, called only for a message: a value read without an error builds no pointer.
+
     /// `value` as a finite number, or a message at `at`.
-    double to_number(const Json& value, const std::string& at) const;
+    template <class At>
+    double to_number(const Json& value, const At& at) const {
+        if (!value.is_number()) source_.fail(at(), "expected a number, got " + describe(value));
+        const double number = value.get<double>();
+        // JSON has no NaN or infinity, but a literal like 1e999 overflows to infinity.
+        if (!std::isfinite(number)) {
+            source_.fail(at(), "expected a finite number, got " + value.dump());
+        }
+        return number;
+    }
+    double to_number(const Json& value, const JsonPointer& at) const {
+        return to_number(value, [&] { return at; });
+    }
+
     /// `value` as a whole number >= 0, or a message at `at`.
-    std::size_t to_count(const Json& value, const std::string& at) const;
+    template <class At>
+    std::size_t to_count(const Json& value, const At& at) const {
+        if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
+            source_.fail(at(), "expected a whole number >= 0, got " + describe(value));
+        }
+        return value.get<std::size_t>();
+    }
+    std::size_t to_count(const Json& value, const JsonPointer& at) const {
+        return to_count(value, [&] { return at; });
+    }
+
     /// `value` as an array of 3 finite numbers, or a message at `at`.
-    Vector3 to_vector(const Json& value, const std::string& at) const;
+    template <class At>
+    Vector3 to_vector(const Json& value, const At& at) const {
+        if (!value.is_array() || value.size() != 3) {
+            source_.fail(at(), "expected an array of 3 numbers, got " + describe(value));
+        }
+        Vector3 vector;
+        for (std::size_t i = 0; i < 3; ++i) {
+            vector[static_cast<Eigen::Index>(i)] =
+                to_number(value[i], [&] { return JsonPointer(at()).child(i); });
+        }
+        return vector;
+    }
+    Vector3 to_vector(const Json& value, const JsonPointer& at) const {
+        return to_vector(value, [&] { return at; });
+    }
 
 private:
     void ask(std::string_view key) {
@@ -93,7 +135,7 @@ private:
     }
 
     const Json& value_;
-    std::string pointer_;
+    JsonPointer pointer_;
     const Source& source_;
     std::string what_;
     std::vector<std::string> asked_;

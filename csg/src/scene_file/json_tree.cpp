@@ -77,11 +77,29 @@ private:
     }
 
     bool place(Json&& value) {
+        count_value();
         *slot() = std::move(value);
         return true;
     }
 
+    /// Fails once the file has more than kMaxJsonValues values, at the one past the limit.
+    void count_value() {
+        if (++values_ <= kMaxJsonValues) return;
+        // The value's own pointer: it has not been put in its place yet.
+        std::string at = path();
+        if (!frames_.empty()) {
+            const Frame& frame = frames_.back();
+            at += '/';
+            at += frame.value->is_array() ? std::to_string(frame.elements)
+                                          : escape_pointer_token(frame.key);
+        }
+        source_.fail(at, "more than " + std::to_string(kMaxJsonValues) +
+                             " JSON values (numbers, strings, arrays and objects; "
+                             "docs/scene-format.md, Limits)");
+    }
+
     bool open(Json::value_t type) {
+        count_value();
         if (frames_.size() >= kMaxJsonDepth) {
             source_.fail(path(), "nesting deeper than " + std::to_string(kMaxJsonDepth) +
                                      " arrays and objects (docs/scene-format.md, Limits)");
@@ -111,6 +129,7 @@ private:
     Json& root_;
     const Source& source_;
     std::vector<Frame> frames_;
+    std::size_t values_ = 0;
 };
 
 }  // namespace

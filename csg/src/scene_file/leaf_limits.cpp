@@ -19,7 +19,7 @@ std::uint64_t expanded_leaves(const Shape& shape,
     return leaves;
 }
 
-void Loader::count_leaves(const Shape& shape, const std::string& pointer) {
+void Loader::count_leaves(const Shape& shape, const JsonPointer& pointer) {
     total_leaves_ = saturating_add(total_leaves_, expanded_leaves(shape, leaves_));
     if (total_leaves_ > kMaxExpandedLeaves) {
         const std::string count = total_leaves_ == std::numeric_limits<std::uint64_t>::max()
@@ -38,8 +38,9 @@ namespace {
 /// Counts the expanded leaves the parsed file describes before anything is built, so a file
 /// over kMaxExpandedLeaves is refused in time linear in its size instead of after building
 /// legal inner structures (a 10^6-sphere grid inside a grid of 10). Each definition is counted
-/// once (memoised by name); a node it does not understand counts as one leaf and is left to
-/// the loader to report. Pointers are assembled from the stack of tokens only for a message.
+/// once (memoised by name); a node it does not understand counts as one leaf (a value that is
+/// no object, none) and is left to the loader to report. Pointers are assembled from the stack
+/// of tokens only for a message.
 class LeafPrescan {
 public:
     LeafPrescan(const Json& root, const DefinitionIndex& index, const Source& source)
@@ -88,7 +89,10 @@ private:
 
     std::uint64_t node(const Json& value, std::size_t depth) {
         // Deeper than the loader allows: the loader reports the depth.
-        if (depth > kMaxShapeDepth || !value.is_object()) return 1;
+        if (depth > kMaxShapeDepth) return 1;
+        // Not a node at all: the loader refuses it where it meets it, so it adds no leaf (a
+        // list of 10^7 zeros is "expected an object" at its first, not a count of leaves).
+        if (!value.is_object()) return 0;
         const auto type = value.find("type");
         if (type == value.end() || !type->is_string()) return 1;
         const std::string& name = type->get_ref<const std::string&>();

@@ -26,6 +26,10 @@ constexpr std::uint64_t kMaxExpandedLeaves = 10'000'000;
 constexpr std::uint64_t kMaxOverlappingLeaves = 10'000;
 /// The file is parsed into memory whole; its tree takes about ten times its size.
 constexpr std::uintmax_t kMaxSceneFileBytes = 256u << 20;
+/// JSON values (numbers, strings, booleans, nulls, arrays, objects) in the file: each costs 16
+/// bytes or more in the tree, so 256 MiB of "0," (2 bytes a value) built a tree of 4.6 GB;
+/// at the limit such a file peaks at 1.3 GB with its text. 10^6 spheres are 7 * 10^6 values.
+constexpr std::size_t kMaxJsonValues = std::size_t{1} << 25;
 /// Keys and names longer than this are cut in messages.
 constexpr std::size_t kLongestShownName = 64;
 /// Lights, positions and distances: their squares must stay finite in the shading.

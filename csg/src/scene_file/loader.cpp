@@ -73,10 +73,10 @@ ShapePointer Loader::painted(ShapePointer shape, std::uint32_t material, Fields&
 std::vector<ListItem> Loader::list(Fields& fields, std::string_view key, std::size_t minimum,
                                    std::string_view of) {
     const Json& array = fields.array(key, 1, of);
-    const std::string pointer = fields.pointer(key);
+    const JsonPointer pointer = fields.pointer(key);
     std::vector<ListItem> items;
     for (std::size_t i = 0; i < array.size(); ++i) {
-        const std::string at = child_pointer(pointer, i);
+        const JsonPointer at = pointer.child(i);
         Fields element(array[i], at, source_, "an element of \"" + std::string(key) + "\"");
         if (is_copies_node(array[i])) {
             for (Copy& copy : copies(element, false)) items.push_back({std::move(copy.shape), at});
@@ -93,7 +93,7 @@ std::vector<ListItem> Loader::list(Fields& fields, std::string_view key, std::si
     return items;
 }
 
-ShapePointer Loader::definition(const std::string& name, const std::string& pointer) {
+ShapePointer Loader::definition(const std::string& name, const JsonPointer& pointer) {
     if (const auto found = built_.find(name); found != built_.end()) return found->second;
     const auto indexed = definition_index_.find(name);
     if (indexed == definition_index_.end()) {
@@ -112,16 +112,26 @@ ShapePointer Loader::definition(const std::string& name, const std::string& poin
                                   (known.empty() ? " (the file has no \"definitions\")"
                                                  : "; defined: " + known));
     }
-    if (std::find(building_.begin(), building_.end(), name) != building_.end()) {
+    if (const auto first = std::find(building_.begin(), building_.end(), name);
+        first != building_.end()) {
+        // Up to 256 names (the depth limit) of any length: the first and last few, each cut.
+        constexpr std::ptrdiff_t kShownEnds = 4;
+        const std::ptrdiff_t length = building_.end() - first;
         std::string cycle;
-        for (auto it = std::find(building_.begin(), building_.end(), name); it != building_.end();
-             ++it) {
-            cycle += *it + " -> ";
+        for (auto it = first; it != building_.end(); ++it) {
+            const std::ptrdiff_t at = it - first;
+            if (at == kShownEnds && length > 2 * kShownEnds) {
+                cycle.append("... (").append(std::to_string(length - 2 * kShownEnds));
+                cycle.append(" more) -> ");
+                it = building_.end() - kShownEnds - 1;
+                continue;
+            }
+            cycle.append(shown(*it)).append(" -> ");
         }
-        source_.fail(pointer, "reference cycle: " + cycle + name);
+        source_.fail(pointer, "reference cycle: " + cycle + shown(name));
     }
     building_.push_back(name);
-    ShapePointer built = shape(*indexed->second, child_pointer("/definitions", name),
+    ShapePointer built = shape(*indexed->second, JsonPointer().child("definitions").child(name),
                                "the definition " + quote_name(name));
     building_.pop_back();
     built_[name] = built;
@@ -129,7 +139,7 @@ ShapePointer Loader::definition(const std::string& name, const std::string& poin
 }
 
 Scene Loader::load() {
-    Fields top(root_, "", source_, "the scene");
+    Fields top(root_, JsonPointer(), source_, "the scene");
     Scene scene;
     // Asked for so finish() accepts them; each is read below.
     for (const char* key :
@@ -153,20 +163,21 @@ Scene Loader::load() {
     prescan_leaves(root_, definition_index_, source_);
     if (definitions_ != nullptr) {
         if (!definitions_->is_object()) {
-            source_.fail("/definitions",
+            source_.fail(std::string("/definitions"),
                          "expected an object of named shapes, got " + describe(*definitions_));
         }
         // Every definition is built, used or not, so its errors are reported.
         for (auto it = definitions_->begin(); it != definitions_->end(); ++it) {
-            definition(it.key(), child_pointer("/definitions", it.key()));
+            definition(it.key(), JsonPointer().child("definitions").child(it.key()));
         }
     }
     const Json& objects = top.array("objects", 0, "objects");
+    const JsonPointer objects_at = top.pointer("objects");
     top.finish();
     // The file's object each scene object came from (a grid or an array gives several).
     std::vector<std::size_t> object_of;
     for (std::size_t i = 0; i < objects.size(); ++i) {
-        Fields fields(objects[i], child_pointer("/objects", i), source_, "a scene object");
+        Fields fields(objects[i], objects_at.child(i), source_, "a scene object");
         const std::string name = fields.string("name", "");
         fields.has("type");  // asked first, for the order of keys a message lists
         if (is_copies_node(objects[i])) {
@@ -194,7 +205,7 @@ Scene Loader::load() {
     for (const SceneObject& object : scene.objects()) shapes.push_back(object.shape.get());
     if (const Overlap overlap = overlapping_leaves(shapes, true, overlaps_);
         overlap.leaves > kMaxOverlappingLeaves) {
-        source_.fail(child_pointer("/objects", object_of[overlap.member]),
+        source_.fail(objects_at.child(object_of[overlap.member]),
                      "with the objects around it, " + overlap_message(overlap.leaves));
     }
     return scene;

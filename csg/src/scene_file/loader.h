@@ -40,7 +40,7 @@ struct ShapeEntry {
 /// the pointer of the node it came from.
 struct ListItem {
     ShapePointer shape;
-    std::string pointer;
+    JsonPointer pointer;
 };
 
 /// One copy made by a grid or an array node: the shape, moved into place, and at the top
@@ -64,8 +64,8 @@ public:
     /// Builds the shape described by the node at `pointer`; `fields` may already have had
     /// top-level keys read from it.
     ShapePointer shape(Fields& fields);
-    ShapePointer shape(const Json& value, const std::string& pointer, std::string_view what) {
-        Fields fields(value, pointer, source_, what);
+    ShapePointer shape(const Json& value, JsonPointer pointer, std::string_view what) {
+        Fields fields(value, std::move(pointer), source_, what);
         ShapePointer built = shape(fields);
         fields.finish();
         return built;
@@ -87,7 +87,7 @@ public:
     ShapePointer painted(ShapePointer shape, std::uint32_t material, Fields& fields,
                          std::string_view key);
 
-    ShapePointer definition(const std::string& name, const std::string& pointer);
+    ShapePointer definition(const std::string& name, const JsonPointer& pointer);
 
     /// A mesh node: the file at "path", relative to the scene file's folder, loaded once per
     /// path and settings however often it is named.
@@ -95,7 +95,7 @@ public:
 
     const Source& source() const { return source_; }
 
-    Transform transform(const Json& list, const std::string& pointer) const;
+    Transform transform(const Json& list, const JsonPointer& pointer) const;
 
 private:
     std::vector<Copy> grid(Fields& fields);
@@ -113,7 +113,7 @@ private:
 
     /// Counts `shape`'s expanded leaves into the scene's total and fails at `pointer` once the
     /// total passes kMaxExpandedLeaves.
-    void count_leaves(const Shape& shape, const std::string& pointer);
+    void count_leaves(const Shape& shape, const JsonPointer& pointer);
 
     const Json& root_;
     const Source& source_;
@@ -148,7 +148,7 @@ std::string known_types();
 /// Fails at `at` unless `transform` and its inverse are finite (transforms.cpp): a product of
 /// finite steps can overflow (scale 1e200 twice) or underflow, whose inverse then overflows
 /// (scale 1e-320). `product` says whether `transform` is a product of steps, for the message.
-void require_representable(const Transform& transform, const Source& source, const std::string& at,
+void require_representable(const Transform& transform, const Source& source, const JsonPointer& at,
                            bool product);
 
 /// `shape` placed by `world_from_object`; nested instances are folded into one.
@@ -177,10 +177,13 @@ struct Overlap {
 
 /// An estimate for a list of members (a compound's children, a boolean's operands, the scene's
 /// objects): the largest sum of the members' overlapping_leaves over the members whose boxes
-/// hold one sample point, the sample points being the centres of up to 64 members' boxes. A
+/// hold one sample point, the sample points being the centres of every member's box. A
 /// member whose box encloses the sample's, or is enclosed by it, with a margin is not counted
 /// (nested shapes are met in turn, not all at once); members with an infinite box are counted
 /// at every point. Exact repeats count once when `drops_repeats` (compounds and the scene).
+/// Long lists are counted through a k-d tree over the boxes, which takes or skips whole
+/// groups of members at once: about n log n for members side by side or nested, never more
+/// box tests than the n^2 of counting each member at each sample.
 Overlap overlapping_leaves(std::span<const Shape* const> members, bool drops_repeats,
                            OverlapMemo& memo);
 

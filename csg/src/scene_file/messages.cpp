@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <vector>
 
 #include "csgrt/csg/scene_file.h"
 #include "limits.h"
@@ -48,12 +49,26 @@ std::string escape_pointer_token(std::string_view token) {
     return escaped;
 }
 
-std::string child_pointer(const std::string& pointer, std::string_view key) {
-    return pointer + "/" + escape_pointer_token(key);
+JsonPointer JsonPointer::child(std::string_view key) const {
+    return JsonPointer(std::make_shared<const Step>(Step{step_, std::string(key), 0, false}));
 }
 
-std::string child_pointer(const std::string& pointer, std::size_t index) {
-    return pointer + "/" + std::to_string(index);
+JsonPointer JsonPointer::child(std::size_t index) const {
+    return JsonPointer(std::make_shared<const Step>(Step{step_, {}, index, true}));
+}
+
+std::string JsonPointer::text() const {
+    std::vector<const Step*> steps;
+    for (const Step* step = step_.get(); step != nullptr; step = step->parent.get()) {
+        steps.push_back(step);
+    }
+    std::string text;
+    for (auto step = steps.rbegin(); step != steps.rend(); ++step) {
+        text += '/';
+        text +=
+            (*step)->is_index ? std::to_string((*step)->index) : escape_pointer_token((*step)->key);
+    }
+    return text;
 }
 
 std::string with_article(std::string_view noun) {

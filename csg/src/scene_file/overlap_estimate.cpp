@@ -17,10 +17,6 @@ namespace csgrt::detail::scene_file {
 
 namespace {
 
-/// Sample points per list: the centres of at most this many members' boxes, evenly strided.
-/// Each is tested against every member, so a list of n members costs at most 64 n box tests.
-constexpr std::size_t kOverlapSamples = 64;
-
 /// Nested members do not pile up: a ray meets the enclosing one first and, once it has a hit
 /// there, skips the box inside (the shells of an onion cost a test or two each). A box
 /// encloses another when it is larger by this fraction of the inner box's diagonal on every
@@ -31,6 +27,138 @@ bool encloses(const Aabb& outer, const Aabb& inner, double margin) {
     return (outer.lower.array() <= inner.lower.array() - margin).all() &&
            (outer.upper.array() >= inner.upper.array() + margin).all();
 }
+
+/// A member of a list with a finite box, as the estimate sees it.
+struct Member {
+    Aabb box;
+    std::uint64_t leaves;
+    std::size_t index;
+};
+
+/// One sample: the centre of a member's box, where the members it neither encloses nor is
+/// enclosed by (with the margin) are counted.
+struct Sample {
+    Aabb box;
+    Point3 point;
+    double margin;
+
+    explicit Sample(const Aabb& member)
+        : box(member),
+          point(member.center()),
+          margin(kEnclosingMargin * member.diagonal().norm()) {}
+
+    bool counts(const Aabb& other) const {
+        return other.contains(point) && !encloses(other, box, margin) &&
+               !encloses(box, other, margin);
+    }
+};
+
+/// Members at most this many are counted at every sample one by one (n^2 box tests); longer
+/// lists go through an OverlapTree, which gives the same sums.
+constexpr std::size_t kDirectMembers = 32;
+
+/// The members' boxes in a k-d tree over the six coordinates of each box (lower and upper
+/// corner), split at the median of the coordinate that varies most: members side by side are
+/// split by position, nested ones (shells with one centre) by size. Each node knows the union
+/// and the common part of the boxes below it, so a sample takes a whole node at once when
+/// every member in it counts there, or skips it when none can: a node whose union misses the
+/// point, whose common part encloses the sample, or whose union the sample encloses. Sums are
+/// exactly those of testing every member at the sample.
+class OverlapTree {
+public:
+    explicit OverlapTree(std::vector<Member>& members) : members_(members) {
+        nodes_.reserve(2 * (members.size() / kLeafMembers + 1));
+        build(0, members.size());
+    }
+
+    /// The leaves of the members `sample` counts, saturating.
+    std::uint64_t count(const Sample& sample) const { return count(0, sample); }
+
+private:
+    static constexpr std::size_t kLeafMembers = 8;
+
+    struct Node {
+        Aabb all;
+        /// The intersection of the members' boxes (empty when they share no point).
+        Aabb common;
+        std::uint64_t leaves = 0;
+        std::size_t begin = 0, end = 0;
+        /// The children's indices; 0 (the root, never a child) for a leaf node.
+        std::size_t first = 0, second = 0;
+    };
+
+    static double coordinate(const Aabb& box, int k) {
+        return k < 3 ? box.lower[k] : box.upper[k - 3];
+    }
+
+    std::size_t build(std::size_t begin, std::size_t end) {
+        const std::size_t at = nodes_.size();
+        nodes_.emplace_back();
+        Node node;
+        node.begin = begin;
+        node.end = end;
+        node.common.lower = Point3::Constant(-kInfinity);
+        node.common.upper = Point3::Constant(kInfinity);
+        double low[6], high[6];
+        std::fill(low, low + 6, kInfinity);
+        std::fill(high, high + 6, -kInfinity);
+        for (std::size_t i = begin; i < end; ++i) {
+            const Aabb& box = members_[i].box;
+            node.all.extend(box);
+            node.common.lower = node.common.lower.cwiseMax(box.lower);
+            node.common.upper = node.common.upper.cwiseMin(box.upper);
+            node.leaves = saturating_add(node.leaves, members_[i].leaves);
+            for (int k = 0; k < 6; ++k) {
+                low[k] = std::min(low[k], coordinate(box, k));
+                high[k] = std::max(high[k], coordinate(box, k));
+            }
+        }
+        if (end - begin > kLeafMembers) {
+            int split = 0;
+            for (int k = 1; k < 6; ++k) {
+                if (high[k] - low[k] > high[split] - low[split]) split = k;
+            }
+            const std::size_t middle = begin + (end - begin) / 2;
+            std::nth_element(members_.begin() + static_cast<std::ptrdiff_t>(begin),
+                             members_.begin() + static_cast<std::ptrdiff_t>(middle),
+                             members_.begin() + static_cast<std::ptrdiff_t>(end),
+                             [split](const Member& a, const Member& b) {
+                                 return coordinate(a.box, split) < coordinate(b.box, split);
+                             });
+            node.first = build(begin, middle);
+            node.second = build(middle, end);
+        }
+        nodes_[at] = node;
+        return at;
+    }
+
+    std::uint64_t count(std::size_t at, const Sample& sample) const {
+        const Node& node = nodes_[at];
+        if (!node.all.contains(sample.point) || encloses(node.common, sample.box, sample.margin) ||
+            encloses(sample.box, node.all, sample.margin)) {
+            return 0;
+        }
+        // Every member holds the point (each holds the common part), none encloses the sample
+        // (each lies in the union) and the sample encloses none (each holds the common part).
+        if (node.common.contains(sample.point) && !encloses(node.all, sample.box, sample.margin) &&
+            !encloses(sample.box, node.common, sample.margin)) {
+            return node.leaves;
+        }
+        if (node.first == 0) {
+            std::uint64_t leaves = 0;
+            for (std::size_t i = node.begin; i < node.end; ++i) {
+                if (sample.counts(members_[i].box)) {
+                    leaves = saturating_add(leaves, members_[i].leaves);
+                }
+            }
+            return leaves;
+        }
+        return saturating_add(count(node.first, sample), count(node.second, sample));
+    }
+
+    std::vector<Member>& members_;
+    std::vector<Node> nodes_;
+};
 
 }  // namespace
 
@@ -52,11 +180,6 @@ Overlap overlapping_leaves(std::span<const Shape* const> members, bool drops_rep
                            OverlapMemo& memo) {
     std::vector<bool> repeats(members.size(), false);
     if (drops_repeats) repeats = exact_repeats(members);
-    struct Member {
-        Aabb box;
-        std::uint64_t leaves;
-        std::size_t index;
-    };
     std::vector<Member> bounded;
     // Members without a finite box (planes) are tested on every ray.
     std::uint64_t everywhere = 0;
@@ -75,19 +198,33 @@ Overlap overlapping_leaves(std::span<const Shape* const> members, bool drops_rep
         if (leaves > worst.leaves) worst = {leaves, i};
     }
     worst.leaves = std::max(worst.leaves, everywhere);
-    const std::size_t stride = std::max<std::size_t>(1, bounded.size() / kOverlapSamples);
-    for (std::size_t s = 0; s < bounded.size(); s += stride) {
-        const Aabb& sample = bounded[s].box;
-        const Point3 point = sample.center();
-        const double margin = kEnclosingMargin * sample.diagonal().norm();
-        std::uint64_t leaves = everywhere;
-        for (const Member& member : bounded) {
-            if (member.box.contains(point) && !encloses(member.box, sample, margin) &&
-                !encloses(sample, member.box, margin)) {
-                leaves = saturating_add(leaves, member.leaves);
+    // Every member's centre is a sample, so a pile anywhere in a long list is found. The
+    // samples are compared in the members' order, so the first member of the worst pile is
+    // named.
+    std::vector<std::uint64_t> at_member(members.size(), 0);
+    std::vector<char> sampled(members.size(), 0);
+    if (bounded.size() <= kDirectMembers) {
+        for (const Member& at : bounded) {
+            const Sample sample(at.box);
+            for (const Member& member : bounded) {
+                if (sample.counts(member.box)) {
+                    at_member[at.index] = saturating_add(at_member[at.index], member.leaves);
+                }
             }
+            sampled[at.index] = 1;
         }
-        if (leaves > worst.leaves) worst = {leaves, bounded[s].index};
+    } else {
+        // The tree reorders `bounded`; each member keeps its index.
+        const OverlapTree tree(bounded);
+        for (const Member& at : bounded) {
+            at_member[at.index] = tree.count(Sample(at.box));
+            sampled[at.index] = 1;
+        }
+    }
+    for (std::size_t i = 0; i < members.size(); ++i) {
+        if (!sampled[i]) continue;
+        const std::uint64_t leaves = saturating_add(everywhere, at_member[i]);
+        if (leaves > worst.leaves) worst = {leaves, i};
     }
     return worst;
 }

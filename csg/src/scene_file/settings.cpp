@@ -37,7 +37,7 @@ void require_length(const Vector3& v, Fields& fields, std::string_view key, std:
 void Loader::camera(Scene& scene) {
     Camera camera;
     if (root_.contains("camera")) {
-        Fields fields(root_.at("camera"), "/camera", source_, "the camera");
+        Fields fields(root_.at("camera"), JsonPointer().child("camera"), source_, "the camera");
         const std::string projection = fields.string("projection", "pinhole");
         if (projection == "orthographic") {
             camera.projection = Camera::Projection::Orthographic;
@@ -75,11 +75,11 @@ void Loader::materials(Scene& scene, std::map<std::string, std::uint32_t>& by_na
     if (!root_.contains("materials")) return;
     const Json& materials = root_.at("materials");
     if (!materials.is_object()) {
-        source_.fail("/materials",
+        source_.fail(std::string("/materials"),
                      "expected an object of named materials, got " + describe(materials));
     }
     for (auto it = materials.begin(); it != materials.end(); ++it) {
-        const std::string at = child_pointer("/materials", it.key());
+        const JsonPointer at = JsonPointer().child("materials").child(it.key());
         if (it.key() == "default") {
             source_.fail(at, "the name \"default\" is taken by material 0, the neutral grey");
         }
@@ -108,7 +108,7 @@ void Loader::materials(Scene& scene, std::map<std::string, std::uint32_t>& by_na
         try {
             by_name[it.key()] = scene.add_material(material);
         } catch (const InvalidParameter& error) {
-            source_.fail(child_pointer(at, "albedo"), error.what());
+            source_.fail(at.child("albedo"), error.what());
         }
     }
 }
@@ -117,10 +117,11 @@ void Loader::lights(Scene& scene) {
     if (!root_.contains("lights")) return;
     const Json& lights = root_.at("lights");
     if (!lights.is_array()) {
-        source_.fail("/lights", "expected an array of lights, got " + describe(lights));
+        source_.fail(std::string("/lights"),
+                     "expected an array of lights, got " + describe(lights));
     }
     for (std::size_t i = 0; i < lights.size(); ++i) {
-        const std::string at = child_pointer("/lights", i);
+        const JsonPointer at = JsonPointer().child("lights").child(i);
         Fields fields(lights[i], at, source_, "a light");
         const std::string type = fields.string("type");
         auto check_colour = [&](std::string_view key, const Vector3& colour) {
@@ -223,7 +224,7 @@ void Loader::lights(Scene& scene) {
 /// The top-level "ambient" and "background" colours (docs/scene-format.md): linear radiance,
 /// each channel in [0, kMaxIntensity].
 void Loader::ambient_and_background(Scene& scene) {
-    Fields fields(root_, "", source_, "the scene");
+    Fields fields(root_, JsonPointer(), source_, "the scene");
     for (const char* key : {"ambient", "background"}) {
         if (!root_.contains(key)) continue;
         const Vector3 colour = fields.colour(key, Vector3::Zero());

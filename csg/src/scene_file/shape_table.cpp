@@ -252,7 +252,7 @@ std::string known_types() {
 [[noreturn]] void rethrow_invalid(const InvalidParameter& error, const Fields& fields,
                                   const Json& node, bool angles) {
     std::string message = error.what();
-    std::string pointer = fields.pointer();
+    JsonPointer pointer = fields.pointer();
     std::string parameter = error.parameter();
     // The structure name of a compound or grid is its "accelerator" key; the keys every node
     // may have are never a shape's parameter.

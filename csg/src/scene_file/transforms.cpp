@@ -3,7 +3,7 @@
 
 namespace csgrt::detail::scene_file {
 
-void require_representable(const Transform& transform, const Source& source, const std::string& at,
+void require_representable(const Transform& transform, const Source& source, const JsonPointer& at,
                            bool product) {
     const bool forward = transform.linear().allFinite() && transform.translation().allFinite();
     const bool backward =
@@ -24,11 +24,11 @@ ShapePointer place(ShapePointer shape, const Transform& world_from_object) {
     return std::make_shared<Instance>(std::move(shape), world_from_object);
 }
 
-Transform Loader::transform(const Json& list, const std::string& pointer) const {
+Transform Loader::transform(const Json& list, const JsonPointer& pointer) const {
     // Each entry acts on the result of the ones before it: world = T_n ... T_2 T_1.
     Transform world_from_object;
     for (std::size_t i = 0; i < list.size(); ++i) {
-        const std::string at = child_pointer(pointer, i);
+        const JsonPointer at = pointer.child(i);
         const Json& entry = list[i];
         if (!entry.is_object() || entry.size() != 1) {
             source_.fail(at,
@@ -38,7 +38,7 @@ Transform Loader::transform(const Json& list, const std::string& pointer) const 
         }
         const std::string kind = entry.begin().key();
         const Json& value = entry.begin().value();
-        const std::string value_at = child_pointer(at, kind);
+        const JsonPointer value_at = at.child(kind);
         Fields probe(entry, at, source_, "a transform");
         Transform step;
         try {
@@ -73,21 +73,22 @@ Transform Loader::transform(const Json& list, const std::string& pointer) const 
                 Eigen::Matrix4d matrix;
                 for (int row = 0; row < 4; ++row) {
                     const Json& values = value[row];
-                    const std::string row_at = child_pointer(value_at, row);
+                    const JsonPointer row_at = value_at.child(static_cast<std::size_t>(row));
                     if (!values.is_array() || values.size() != 4) {
                         source_.fail(row_at,
                                      "expected a row of 4 numbers, got " + describe(values));
                     }
                     for (int column = 0; column < 4; ++column) {
-                        matrix(row, column) =
-                            probe.to_number(values[column], child_pointer(row_at, column));
+                        matrix(row, column) = probe.to_number(values[column], [&] {
+                            return row_at.child(static_cast<std::size_t>(column));
+                        });
                     }
                 }
                 step = Transform::from_matrix(matrix);
             } else {
-                source_.fail(child_pointer(at, kind),
-                             "unknown transform \"" + kind +
-                                 "\"; expected one of: translate, rotate, scale, shear, matrix");
+                source_.fail(at.child(kind),
+                             "unknown transform " + quote_name(kind) +
+                                 "; expected one of: translate, rotate, scale, shear, matrix");
             }
         } catch (const InvalidParameter& error) {
             source_.fail(value_at, error.what());
