@@ -1,6 +1,8 @@
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +18,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <vector>
 
 #include "command_line_internal.h"
@@ -32,6 +35,27 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+/// Fails unless a file can be made in `directory`, by making one (named as the writer's
+/// temporaries, so the signal handler would remove it too) and removing it: permission bits
+/// alone do not say, since root passes them all and still cannot write to a read-only
+/// filesystem, /sys or /proc.
+void require_can_create_files(const fs::path& directory, const fs::path& output) {
+    // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on chained string +.
+    std::string name = ".";
+    name.append(output.filename().string()).append(".tmp-");
+    name.append(std::to_string(::getpid())).append("-probe");
+    const fs::path probe = directory / name;
+    const int file = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (file < 0) {
+        // A file of that name is there already: the folder takes files.
+        if (errno == EEXIST) return;
+        throw UsageError("output directory '" + directory.string() +
+                         "' is not writable: " + std::strerror(errno));
+    }
+    ::close(file);
+    ::unlink(probe.c_str());
+}
+
 /// Fails early, before any work, for an output the writer could not produce or that would
 /// replace the scene it renders.
 void check_output_path(const fs::path& path, const fs::path& scene, bool with_cost_sheet) {
@@ -41,13 +65,18 @@ void check_output_path(const fs::path& path, const fs::path& scene, bool with_co
     }
     const fs::path directory = path.parent_path().empty() ? fs::path(".") : path.parent_path();
     std::error_code error;
-    if (!fs::is_directory(directory, error)) {
+    const fs::file_status status = fs::status(directory, error);
+    if (error == std::errc::not_a_directory) {
+        throw UsageError("output directory '" + directory.string() +
+                         "' is not a directory: a folder on its path is a file");
+    }
+    if (!fs::exists(status)) {
         throw UsageError("output directory '" + directory.string() + "' does not exist");
     }
-    if (::access(directory.c_str(), W_OK | X_OK) != 0) {
-        throw UsageError("output directory '" + directory.string() +
-                         "' is not writable: " + std::strerror(errno));
+    if (!fs::is_directory(status)) {
+        throw UsageError("output directory '" + directory.string() + "' is not a directory");
     }
+    require_can_create_files(directory, path);
     for (const fs::path& target : render_file_paths(path, with_cost_sheet)) {
         if (fs::is_directory(target, error)) {
             throw UsageError("output '" + target.string() + "' is a directory");

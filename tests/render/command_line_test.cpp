@@ -303,16 +303,34 @@ TEST_F(CommandLine, AnOutputThatIsTheSceneIsRefusedInEverySpelling) {
 }
 
 TEST_F(CommandLine, AnUnwritableOutputFolderIsRefusedBeforeRendering) {
+    // The folder is tried by making a file in it, not by its permission bits, which root
+    // passes: so each case below fails for root too, except the permission bits themselves.
+    // The folder is a regular file, or a folder on its path is.
+    std::ofstream(directory_ / "file.txt") << "x";
+    expect_one_line_error(
+        run({"render", scene_, "-o", (directory_ / "file.txt" / "out.exr").string()}),
+        "file.txt' is not a directory", 2);
+    expect_one_line_error(
+        run({"render", scene_, "-o", (directory_ / "file.txt" / "sub" / "out.exr").string()}),
+        "sub' is not a directory: a folder on its path is a file", 2);
+    // sysfs takes no new files, whoever asks (EACCES, or EROFS where it is mounted read-only).
+    if (fs::is_directory("/sys")) {
+        expect_one_line_error(run({"render", scene_, "-o", "/sys/out.exr"}),
+                              "output directory '/sys' is not writable: ", 2);
+        EXPECT_FALSE(fs::exists("/sys/out.exr"));
+    }
+    // Permission bits, which stop everyone but root.
     const fs::path folder = directory_ / "read_only";
     fs::create_directory(folder);
     fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec);
-    if (::access(folder.c_str(), W_OK) == 0) {
-        fs::permissions(folder, fs::perms::owner_all);
-        GTEST_SKIP() << "running as root: every folder is writable";
+    if (::geteuid() != 0) {
+        const ProgramRun result = run({"render", scene_, "-o", (folder / "out.exr").string()});
+        expect_one_line_error(result, "' is not writable: Permission denied", 2);
     }
-    const ProgramRun result = run({"render", scene_, "-o", (folder / "out.exr").string()});
     fs::permissions(folder, fs::perms::owner_all);
-    expect_one_line_error(result, "' is not writable: Permission denied", 2);  // a usage error
+    fs::remove(folder);
+    fs::remove(directory_ / "file.txt");
+    expect_no_output();
 }
 
 TEST_F(CommandLine, AnImageLargerThanMemoryIsRefusedWithTheEstimate) {
