@@ -307,6 +307,28 @@ TEST(MeshIo, PlyFormatVersionOneWithoutDecimalsLoadsAsTheToolsReadIt) {
     EXPECT_NE(mesh_error(path).find("expected 'format <type> 1.0'"), std::string::npos);
 }
 
+TEST(MeshIo, PlyHeaderLinesTheToolsTolerateLoadAsTheFixture) {
+    // What exporters write and OpenMesh and assimp read (docs/meshes.md): obj_info and
+    // comment lines anywhere in the header, blank header lines, CRLF line ends throughout.
+    ScratchFolder folder;
+    std::istringstream lines(read_text(kFixtures / "box_ascii.ply"));
+    std::string text;
+    for (std::string line; std::getline(lines, line);) {
+        text += line + "\r\n";
+        if (line.rfind("format ", 0) == 0) text += "obj_info written by a test\r\n\r\n";
+        if (line.rfind("element face", 0) == 0) text += "comment between elements\r\n";
+    }
+    const std::filesystem::path path = folder.path() / "box.ply";
+    std::ofstream(path, std::ios::binary) << text;
+    MeshReport report, reference;
+    const TriangleMeshData mesh = load_mesh(path, &report);
+    const TriangleMeshData expected = load_mesh(kFixtures / "box_ascii.ply", &reference);
+    EXPECT_EQ(mesh.vertices, expected.vertices);
+    EXPECT_EQ(mesh.triangles, expected.triangles);
+    EXPECT_EQ(report.faces, reference.faces);
+    EXPECT_TRUE(report.is_closed);
+}
+
 TEST(MeshIo, AsciiStlWithSeveralSolidsIsOneMesh) {
     // The fixture's 12 facets, then the same box moved by 10 in x as a second solid: 24
     // triangles, two closed components, as exporters write several parts.
