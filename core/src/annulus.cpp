@@ -39,23 +39,13 @@ std::optional<Crossing> Annulus::crossing(const Ray& ray) const {
     return Crossing{.t = t};
 }
 
-Hit Annulus::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
-    const Vector3 offset = (ray.origin - center_) + record.t * ray.direction;
-    const Vector3 local = frame_.to_local(offset);
-    // Back onto the plane: drop the normal component that rounding left.
-    hit.point = center_ + local.x() * frame_.x_axis + local.z() * frame_.z_axis;
-    hit.geometric_normal = frame_.normal;
-    hit.shading_normal = frame_.normal;
-    const double r = std::hypot(local.x(), local.z());
+SurfacePoint Annulus::surface_at(const Ray& ray, const HitRecord& record) const {
+    const detail::FramePoint p = detail::point_in_frame(ray, record.t, center_, frame_);
+    const double r = std::hypot(p.x, p.z);
     const double radial = (r - inner_radius_) / (outer_radius_ - inner_radius_);
-    hit.uv = Vector2(std::clamp(radial, 0.0, 1.0),
-                     azimuth_.fraction(AngleRange::azimuth(local.x(), local.z())));
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(frame_.normal) < 0.0;
-    return hit;
+    return {
+        p.point, frame_.normal,
+        Vector2(std::clamp(radial, 0.0, 1.0), azimuth_.fraction(AngleRange::azimuth(p.x, p.z)))};
 }
 
 template class detail::LeafShape<Annulus>;

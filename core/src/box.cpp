@@ -81,27 +81,19 @@ bool Box::contains(const Point3& p) const {
     return (p.array() >= lower_.array()).all() && (p.array() <= upper_.array()).all();
 }
 
-Hit Box::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
+SurfacePoint Box::surface_at(const Ray& ray, const HitRecord& record) const {
     const int face = static_cast<int>(record.primitive);
     const int axis = face / 2;
     const bool upper_side = face % 2 == 1;
     // o + t d rounded, then put exactly on the face and clamped into its rectangle.
     Point3 point = ray.at(record.t).cwiseMax(lower_).cwiseMin(upper_);
     point[axis] = upper_side ? upper_[axis] : lower_[axis];
-    hit.point = point;
-    hit.geometric_normal = Normal3::Zero();
-    hit.geometric_normal[axis] = upper_side ? 1.0 : -1.0;
-    hit.shading_normal = hit.geometric_normal;
+    Normal3 normal = Normal3::Zero();
+    normal[axis] = upper_side ? 1.0 : -1.0;
     const int u_axis = (axis + 1) % 3, v_axis = (axis + 2) % 3;
-    hit.uv = Vector2((point[u_axis] - lower_[u_axis]) / (upper_[u_axis] - lower_[u_axis]),
+    const Vector2 uv((point[u_axis] - lower_[u_axis]) / (upper_[u_axis] - lower_[u_axis]),
                      (point[v_axis] - lower_[v_axis]) / (upper_[v_axis] - lower_[v_axis]));
-    hit.uv = hit.uv.cwiseMax(0.0).cwiseMin(1.0);
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
-    return hit;
+    return {point, normal, uv.cwiseMax(0.0).cwiseMin(1.0)};
 }
 
 template class detail::LeafShape<Box>;

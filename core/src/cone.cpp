@@ -58,6 +58,17 @@ detail::LineInterval Cone::side_interval(const Ray& ray) const {
     const double a = d.x() * d.x() + d.z() * d.z() - rate * rate;
     const double b = o.x() * d.x() + o.z() * d.z() - radius * rate;
     const double c = o.x() * o.x() + o.z() * o.z() - radius * radius;
+    // The line inside from t on, or up to t.
+    const auto from = [&line](double t) {
+        line.t0 = t;
+        line.t1 = kInfinity;
+        return line;
+    };
+    const auto until = [&line](double t) {
+        line.t0 = -kInfinity;
+        line.t1 = t;
+        return line;
+    };
     double roots[2];
     const int count = solve_quadratic(a, 2.0 * b, c, roots);
     if (count == 2) {
@@ -65,50 +76,30 @@ detail::LineInterval Cone::side_interval(const Ray& ray) const {
             // Inside between the roots.
             line.t0 = shift + roots[0];
             line.t1 = shift + roots[1];
-        } else if (rate > 0.0) {
-            // Steeper than the side: inside beyond each root, one piece per nappe; ours is the
-            // one toward which rho grows.
-            line.t0 = shift + roots[1];
-            line.t1 = kInfinity;
-        } else {
-            line.t0 = -kInfinity;
-            line.t1 = shift + roots[0];
+            return line;
         }
-        return line;
+        // Steeper than the side: inside beyond each root, one piece per nappe; ours is the one
+        // toward which rho grows.
+        return rate > 0.0 ? from(shift + roots[1]) : until(shift + roots[0]);
     }
     if (count == 1) {
         // a == 0: parallel to a generator, inside on one side of the one crossing.
-        if (b < 0.0) {
-            line.t0 = shift + roots[0];
-            line.t1 = kInfinity;
-        } else {
-            line.t0 = -kInfinity;
-            line.t1 = shift + roots[0];
-        }
-        return line;
+        return b < 0.0 ? from(shift + roots[0]) : until(shift + roots[0]);
     }
     // No crossing, yet inside all along when a < 0 (rounding has hidden the double root of a
     // line through the apex), or when a == b == 0 and c <= 0 (a line lying in the side, which
     // passes the apex, or one parallel to the axis inside a cylinder-like cone).
     if (!(a < 0.0 || (a == 0.0 && c <= 0.0))) return line;
-    if (rate == 0.0) {
-        // Then a == 0 means a vertical line, inside (or on) a cylinder-like cone.
-        line.t0 = -kInfinity;
-        line.t1 = kInfinity;
-        return line;
-    }
+    // Then a == 0 means a vertical line, inside (or on) a cylinder-like cone.
+    if (rate == 0.0) return from(-kInfinity);
     // Our nappe is the side of the apex plane where rho > 0.
     const double t_apex = shift - radius / rate;
     if (rate > 0.0) {
-        line.t0 = t_apex;
         line.surface0 = kApex;
-        line.t1 = kInfinity;
-    } else {
-        line.t0 = -kInfinity;
-        line.t1 = t_apex;
-        line.surface1 = kApex;
+        return from(t_apex);
     }
-    return line;
+    line.surface1 = kApex;
+    return until(t_apex);
 }
 
 bool Cone::apex_on_line(const Ray& ray, double& t) const {
@@ -184,46 +175,32 @@ bool Cone::contains(const Point3& p) const {
     return p.x() * p.x() + p.z() * p.z() < square(radius_at(p.y()));
 }
 
-Hit Cone::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
+SurfacePoint Cone::surface_at(const Ray& ray, const HitRecord& record) const {
     Point3 p = ray.at(record.t);
     const double distance = std::hypot(p.x(), p.z());
     switch (record.primitive) {
         case kBaseCap:
         case kTopCap: {
             const bool top = record.primitive == kTopCap;
-            p.y() = top ? height_ : 0.0;
-            hit.geometric_normal = Normal3(0.0, top ? 1.0 : -1.0, 0.0);
-            hit.uv = Vector2(AngleRange::azimuth(p.x(), p.z()) / kTwoPi,
-                             std::min(distance / (top ? top_radius_ : base_radius_), 1.0));
-            break;
+            return detail::cap_point(p, distance, top ? height_ : 0.0, top,
+                                     top ? top_radius_ : base_radius_);
         }
         case kSide:
             if (distance > 0.0) {
-                hit.geometric_normal = Normal3(p.x() / distance * normal_radial_, normal_y_,
+                const Normal3 normal = Normal3(p.x() / distance * normal_radial_, normal_y_,
                                                p.z() / distance * normal_radial_)
                                            .normalized();
                 // Move the point along the normal onto the side: (|xz| - rho(y)) cos(half angle)
                 // is its signed distance to the infinite cone there.
-                p -= (distance - radius_at(p.y())) * normal_radial_ * hit.geometric_normal;
-                hit.uv = Vector2(AngleRange::azimuth(p.x(), p.z()) / kTwoPi,
-                                 std::clamp(p.y() / height_, 0.0, 1.0));
-                break;
+                p -= (distance - radius_at(p.y())) * normal_radial_ * normal;
+                return {p, normal,
+                        Vector2(AngleRange::azimuth(p.x(), p.z()) / kTwoPi,
+                                std::clamp(p.y() / height_, 0.0, 1.0))};
             }
             [[fallthrough]];  // on the axis: only the apex of a pointed cone is there
         default:
-            p = apex_;
-            hit.geometric_normal = apex_normal_;
-            hit.uv = Vector2(0.0, apex_.y() / height_);
-            break;
+            return {apex_, apex_normal_, Vector2(0.0, apex_.y() / height_)};
     }
-    hit.point = p;
-    hit.shading_normal = hit.geometric_normal;
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
-    return hit;
 }
 
 template class detail::LeafShape<Cone>;

@@ -53,38 +53,17 @@ bool Cylinder::contains(const Point3& p) const {
            p.y() < y_max_;
 }
 
-Hit Cylinder::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
+SurfacePoint Cylinder::surface_at(const Ray& ray, const HitRecord& record) const {
     Point3 p = ray.at(record.t);
     const double phi = AngleRange::azimuth(p.x(), p.z());
     const double distance = std::hypot(p.x(), p.z());
-    if (record.primitive == kSide) {
-        // Project radially onto the side, which removes the rounding of o + t d along the
-        // normal; a point on the axis (impossible for a true side hit) keeps a fixed normal.
-        if (distance > 0.0) {
-            // The unit radial direction first: normalising p itself would underflow for a
-            // radius of 1e-300 (hypot does not).
-            const Normal3 radial(p.x() / distance, 0.0, p.z() / distance);
-            p.x() = radius_ * radial.x();
-            p.z() = radius_ * radial.z();
-            hit.geometric_normal = radial.normalized();
-        } else {
-            hit.geometric_normal = Normal3(0.0, 0.0, 1.0);
-        }
-        hit.uv = Vector2(phi / kTwoPi, std::clamp((p.y() - y_min_) / (y_max_ - y_min_), 0.0, 1.0));
-    } else {
+    if (record.primitive != kSide) {
         const bool top = record.primitive == kTopCap;
-        p.y() = top ? y_max_ : y_min_;
-        hit.geometric_normal = Normal3(0.0, top ? 1.0 : -1.0, 0.0);
-        hit.uv = Vector2(phi / kTwoPi, std::min(distance / radius_, 1.0));
+        return detail::cap_point(p, distance, top ? y_max_ : y_min_, top, radius_);
     }
-    hit.point = p;
-    hit.shading_normal = hit.geometric_normal;
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
-    return hit;
+    const Normal3 normal = detail::onto_side(p, distance, radius_);
+    return {p, normal,
+            Vector2(phi / kTwoPi, std::clamp((p.y() - y_min_) / (y_max_ - y_min_), 0.0, 1.0))};
 }
 
 template class detail::LeafShape<Cylinder>;

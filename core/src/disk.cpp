@@ -29,23 +29,13 @@ std::optional<Crossing> Disk::crossing(const Ray& ray) const {
     return Crossing{.t = t};
 }
 
-Hit Disk::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
-    const Vector3 offset = (ray.origin - center_) + record.t * ray.direction;
-    const Vector3 local = frame_.to_local(offset);
-    // Back onto the plane: drop the normal component that rounding left.
-    hit.point = center_ + local.x() * frame_.x_axis + local.z() * frame_.z_axis;
-    hit.geometric_normal = frame_.normal;
-    hit.shading_normal = frame_.normal;
-    double phi = std::atan2(local.x(), local.z());
+SurfacePoint Disk::surface_at(const Ray& ray, const HitRecord& record) const {
+    const detail::FramePoint p = detail::point_in_frame(ray, record.t, center_, frame_);
+    double phi = std::atan2(p.x, p.z);
     if (phi < 0.0) phi += kTwoPi;
-    const double r = std::hypot(local.x(), local.z());
-    hit.uv = Vector2(std::min(r / radius_, 1.0), std::min(phi / kTwoPi, 1.0));
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(frame_.normal) < 0.0;
-    return hit;
+    const double r = std::hypot(p.x, p.z);
+    return {p.point, frame_.normal,
+            Vector2(std::min(r / radius_, 1.0), std::min(phi / kTwoPi, 1.0))};
 }
 
 template class detail::LeafShape<Disk>;

@@ -1,7 +1,9 @@
 #pragma once
 
 // What the flat shapes (plane, disk, annulus, rectangle, triangle) share: the frame of their
-// normal and the hit on their plane. Private to core/src.
+// normal and where a hit on their plane lies. Private to core/src.
+
+#include <algorithm>
 
 #include "csgrt/core/error.h"
 #include "csgrt/core/hit.h"
@@ -18,22 +20,34 @@ inline SurfaceFrame frame_of_normal(const Normal3& normal, const char* shape) {
     return SurfaceFrame::around(unit);
 }
 
-/// The hit of a flat shape with unit normal `normal` at record.t, whose point lies `offset`
-/// from `anchor` as o + t d gave it: the component along the normal that rounding left is
-/// dropped from `offset` (written back, for the caller's uv) and the point is anchor + offset.
-/// Everything but uv is filled in.
-inline Hit flat_hit(const Ray& ray, const HitRecord& record, const Shape* shape,
-                    const Point3& anchor, Vector3& offset, const Normal3& normal) {
-    Hit hit;
-    hit.t = record.t;
+/// The point of a flat shape with unit normal `normal` that lies `offset` from `anchor` as
+/// o + t d gave it: the component along the normal that rounding left is dropped from `offset`
+/// (written back, for the caller's uv) and the point is anchor + offset.
+inline Point3 onto_plane(const Point3& anchor, Vector3& offset, const Normal3& normal) {
     offset -= offset.dot(normal) * normal;
-    hit.point = anchor + offset;
-    hit.geometric_normal = normal;
-    hit.shading_normal = normal;
-    hit.shape = shape;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(normal) < 0.0;
-    return hit;
+    return anchor + offset;
+}
+
+/// A point of a flat shape around `center` with frame `frame`, at t along the ray: (x, z) are
+/// its frame coordinates, from the offset (o - c) + t d (accurate when o and c are large but
+/// close), and `point` is center + x x_axis + z z_axis, without the component along the
+/// normal that rounding left.
+struct FramePoint {
+    Point3 point;
+    double x;
+    double z;
+};
+
+inline FramePoint point_in_frame(const Ray& ray, double t, const Point3& center,
+                                 const SurfaceFrame& frame) {
+    const Vector3 local = frame.to_local((ray.origin - center) + t * ray.direction);
+    return {center + local.x() * frame.x_axis + local.z() * frame.z_axis, local.x(), local.z()};
+}
+
+/// The uv a flat shape kept in its record (a triangle's barycentrics, a parallelogram's
+/// (s, t)), clamped into [0, 1].
+inline Vector2 record_uv(const HitRecord& record) {
+    return Vector2(std::clamp(double(record.u), 0.0, 1.0), std::clamp(double(record.v), 0.0, 1.0));
 }
 
 }  // namespace csgrt::detail

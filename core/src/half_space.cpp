@@ -45,10 +45,8 @@ bool HalfSpace::contains(const Point3& p) const {
     return (p - boundary_.point()).dot(boundary_.normal()) < 0.0;
 }
 
-Hit HalfSpace::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit = boundary_.finish(ray, record);
-    hit.shape = this;
-    return hit;
+SurfacePoint HalfSpace::surface_at(const Ray& ray, const HitRecord& record) const {
+    return boundary_.surface_at(ray, record);
 }
 
 template class detail::LeafShape<HalfSpace>;

@@ -5,6 +5,7 @@
 
 #include "csgrt/core/cylinder.h"
 #include "csgrt/core/error.h"
+#include "solid_interval.h"
 
 namespace csgrt {
 
@@ -45,30 +46,12 @@ std::optional<Crossing> PartCylinder::crossing(const Ray& ray) const {
     return {};
 }
 
-Hit PartCylinder::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
+SurfacePoint PartCylinder::surface_at(const Ray& ray, const HitRecord& record) const {
     Point3 p = ray.at(record.t);
-    const double distance = std::hypot(p.x(), p.z());
-    if (distance > 0.0) {
-        // Radial projection onto the side removes the rounding of o + t d along the normal.
-        // The unit radial direction first: normalising p itself would underflow for a
-        // radius of 1e-300 (hypot does not).
-        const Normal3 radial(p.x() / distance, 0.0, p.z() / distance);
-        p.x() = radius_ * radial.x();
-        p.z() = radius_ * radial.z();
-        hit.geometric_normal = radial.normalized();
-    } else {
-        hit.geometric_normal = Normal3(0.0, 0.0, 1.0);
-    }
-    hit.point = p;
-    hit.shading_normal = hit.geometric_normal;
-    hit.uv = Vector2(azimuth_.fraction(AngleRange::azimuth(p.x(), p.z())),
-                     std::clamp((p.y() - y_min_) / (y_max_ - y_min_), 0.0, 1.0));
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
-    return hit;
+    const Normal3 normal = detail::onto_side(p, std::hypot(p.x(), p.z()), radius_);
+    return {p, normal,
+            Vector2(azimuth_.fraction(AngleRange::azimuth(p.x(), p.z())),
+                    std::clamp((p.y() - y_min_) / (y_max_ - y_min_), 0.0, 1.0))};
 }
 
 template class detail::LeafShape<PartCylinder>;

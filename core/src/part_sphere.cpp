@@ -70,22 +70,14 @@ std::optional<Crossing> PartSphere::crossing(const Ray& ray) const {
     return {};
 }
 
-Hit PartSphere::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
-    // Project back onto the sphere, as Sphere::finish does.
+SurfacePoint PartSphere::surface_at(const Ray& ray, const HitRecord& record) const {
+    // Project back onto the sphere, as Sphere::surface_at does.
     const Normal3 normal = sphere_.unit_along((ray.origin - center()) + record.t * ray.direction);
-    hit.point = center() + radius() * normal;
-    hit.geometric_normal = normal;
-    hit.shading_normal = hit.geometric_normal;
     const double theta = std::acos(std::clamp(normal.y(), -1.0, 1.0));
     const double v = (theta_max_ - theta) / (theta_max_ - theta_min_);
-    hit.uv = Vector2(azimuth_.fraction(AngleRange::azimuth(normal.x(), normal.z())),
-                     std::clamp(v, 0.0, 1.0));
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
-    return hit;
+    return {center() + radius() * normal, normal,
+            Vector2(azimuth_.fraction(AngleRange::azimuth(normal.x(), normal.z())),
+                    std::clamp(v, 0.0, 1.0))};
 }
 
 template class detail::LeafShape<PartSphere>;

@@ -57,13 +57,12 @@ std::optional<Crossing> PartTorus::crossing(const Ray& ray) const {
     return {};
 }
 
-Hit PartTorus::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit = torus_.finish(ray, record);
+SurfacePoint PartTorus::surface_at(const Ray& ray, const HitRecord& record) const {
+    SurfacePoint surface = torus_.surface_at(ray, record);
     double phi, theta;
-    torus_.surface_angles(hit.point, phi, theta);
-    hit.uv = Vector2(phi_range_.fraction(phi), theta_range_.fraction(theta));
-    hit.shape = this;
-    return hit;
+    torus_.surface_angles(surface.point, phi, theta);
+    surface.uv = Vector2(phi_range_.fraction(phi), theta_range_.fraction(theta));
+    return surface;
 }
 
 template class detail::LeafShape<PartTorus>;

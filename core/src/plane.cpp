@@ -29,11 +29,11 @@ std::optional<Crossing> Plane::crossing(const Ray& ray) const {
     return Crossing{.t = t};
 }
 
-Hit Plane::finish(const Ray& ray, const HitRecord& record) const {
+SurfacePoint Plane::surface_at(const Ray& ray, const HitRecord& record) const {
     Vector3 offset = ray.at(record.t) - point_;
-    Hit hit = detail::flat_hit(ray, record, this, point_, offset, frame_.normal);
-    hit.uv = Vector2(wrap_unit(offset.dot(frame_.x_axis)), wrap_unit(offset.dot(frame_.z_axis)));
-    return hit;
+    const Point3 point = detail::onto_plane(point_, offset, frame_.normal);
+    return {point, frame_.normal,
+            Vector2(wrap_unit(offset.dot(frame_.x_axis)), wrap_unit(offset.dot(frame_.z_axis)))};
 }
 
 template class detail::LeafShape<Plane>;

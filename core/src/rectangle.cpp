@@ -52,12 +52,9 @@ std::optional<Crossing> Rectangle::crossing(const Ray& ray) const {
     return Crossing{.t = t, .u = static_cast<float>(s), .v = static_cast<float>(r)};
 }
 
-Hit Rectangle::finish(const Ray& ray, const HitRecord& record) const {
+SurfacePoint Rectangle::surface_at(const Ray& ray, const HitRecord& record) const {
     Vector3 offset = (ray.origin - corner_) + record.t * ray.direction;
-    Hit hit = detail::flat_hit(ray, record, this, corner_, offset, normal_);
-    hit.uv =
-        Vector2(std::clamp(double(record.u), 0.0, 1.0), std::clamp(double(record.v), 0.0, 1.0));
-    return hit;
+    return {detail::onto_plane(corner_, offset, normal_), normal_, detail::record_uv(record)};
 }
 
 template class detail::LeafShape<Rectangle>;

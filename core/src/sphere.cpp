@@ -93,22 +93,13 @@ bool Sphere::contains(const Point3& p) const {
     return ((p - center_) * scale_).squaredNorm() < radius * radius;
 }
 
-Hit Sphere::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
+SurfacePoint Sphere::surface_at(const Ray& ray, const HitRecord& record) const {
     // Project back onto the sphere: removes the rounding of o + t d along the normal.
     const Normal3 normal = unit_along(ray.at(record.t) - center_);
-    hit.point = center_ + radius_ * normal;
-    hit.geometric_normal = normal;
-    hit.shading_normal = hit.geometric_normal;
     double phi = std::atan2(normal.x(), normal.z());
     if (phi < 0.0) phi += kTwoPi;
     const double theta = std::acos(std::clamp(normal.y(), -1.0, 1.0));
-    hit.uv = Vector2(phi / kTwoPi, 1.0 - theta / kPi);
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(hit.geometric_normal) < 0.0;
-    return hit;
+    return {center_ + radius_ * normal, normal, Vector2(phi / kTwoPi, 1.0 - theta / kPi)};
 }
 
 template class detail::LeafShape<Sphere>;

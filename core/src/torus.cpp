@@ -225,9 +225,7 @@ void Torus::surface_angles(const Point3& p, double& phi, double& theta) const {
     if (theta < 0.0) theta += kTwoPi;
 }
 
-Hit Torus::finish(const Ray& ray, const HitRecord& record) const {
-    Hit hit;
-    hit.t = record.t;
+SurfacePoint Torus::surface_at(const Ray& ray, const HitRecord& record) const {
     const Point3 p = ray.at(record.t);
     // The nearest point of the core circle; the normal points from it to the hit point (the
     // gradient of the tube function, parallel to the quartic's on the surface).
@@ -238,16 +236,10 @@ Hit Torus::finish(const Ray& ray, const HitRecord& record) const {
     const double length = normal.norm();
     normal = length > 0.0 ? Vector3(normal / length) : radial;
     // Project back onto the surface: removes the rounding of o + t d along the normal.
-    hit.point = core + minor_radius_ * normal;
-    hit.geometric_normal = normal;
-    hit.shading_normal = normal;
+    const Point3 point = core + minor_radius_ * normal;
     double phi, theta;
-    surface_angles(hit.point, phi, theta);
-    hit.uv = Vector2(phi / kTwoPi, theta / kTwoPi);
-    hit.shape = this;
-    hit.primitive_id = record.primitive;
-    hit.front_face = ray.direction.dot(normal) < 0.0;
-    return hit;
+    surface_angles(point, phi, theta);
+    return {point, normal, Vector2(phi / kTwoPi, theta / kTwoPi)};
 }
 
 template class detail::LeafShape<Torus>;

@@ -131,12 +131,9 @@ std::optional<Crossing> Triangle::crossing(const Ray& ray) const {
     return scaled_crossing(a, b, c, ray);
 }
 
-Hit Triangle::finish(const Ray& ray, const HitRecord& record) const {
+SurfacePoint Triangle::surface_at(const Ray& ray, const HitRecord& record) const {
     Vector3 offset = ray.at(record.t) - vertices_[0];
-    Hit hit = detail::flat_hit(ray, record, this, vertices_[0], offset, normal_);
-    hit.uv =
-        Vector2(std::clamp(double(record.u), 0.0, 1.0), std::clamp(double(record.v), 0.0, 1.0));
-    return hit;
+    return {detail::onto_plane(vertices_[0], offset, normal_), normal_, detail::record_uv(record)};
 }
 
 template class detail::LeafShape<Triangle>;

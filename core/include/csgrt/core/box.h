@@ -27,7 +27,8 @@ public:
     void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
     /// Closed: points on the faces are inside.
     bool contains(const Point3& p) const override;
-    Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// Where the hit of a record `crossing` made lies, its normal and uv (LeafShape::finish).
+    SurfacePoint surface_at(const Ray& ray, const HitRecord& record) const;
     /// The nearest point in [t_min, t_max] where the ray meets the box (from inside: where it
     /// leaves); `primitive` is the face.
     std::optional<Crossing> crossing(const Ray& ray) const;

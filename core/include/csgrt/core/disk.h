@@ -20,7 +20,8 @@ public:
     std::string_view kind() const override { return "disk"; }
     Aabb bounds() const override;
 
-    Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// Where the hit of a record `crossing` made lies, its normal and uv (LeafShape::finish).
+    SurfacePoint surface_at(const Ray& ray, const HitRecord& record) const;
     /// The point in [t_min, t_max] where the ray crosses the disk, if any.
     std::optional<Crossing> crossing(const Ray& ray) const;
 

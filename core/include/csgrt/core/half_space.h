@@ -25,7 +25,8 @@ public:
 
     void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
     bool contains(const Point3& p) const override;
-    Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// Where the hit of a record `crossing` made lies, its normal and uv (LeafShape::finish).
+    SurfacePoint surface_at(const Ray& ray, const HitRecord& record) const;
     /// The point in [t_min, t_max] where the ray crosses the boundary plane, if any.
     std::optional<Crossing> crossing(const Ray& ray) const { return boundary_.crossing(ray); }
 

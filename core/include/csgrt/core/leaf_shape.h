@@ -18,6 +18,16 @@ struct Crossing {
     float v = 0.0f;
 };
 
+/// What a leaf computes to finish a hit: the point on its surface (the rounding of o + t d
+/// along the normal removed), its unit normal as the surface defines it (outward for solids)
+/// and its uv. The rest of a Hit (t, the ids, the shading normal of an analytic surface,
+/// which side was hit) is the same for every leaf and written once, by LeafShape::finish.
+struct SurfacePoint {
+    Point3 point;
+    Normal3 normal;
+    Vector2 uv;
+};
+
 namespace detail {
 
 /// The two hit queries of a leaf shape written once, from the one routine each leaf has:
@@ -26,6 +36,10 @@ namespace detail {
 /// `any_hit` asks whether there is one. A leaf whose `any_hit` could stop earlier than its
 /// nearest crossing overrides it; none of the analytic shapes can (their crossing is one root
 /// choice), so none does.
+///
+/// `finish` is written once too, from `SurfacePoint Derived::surface_at(const Ray&, const
+/// HitRecord&) const` (the record is one this leaf made for this ray): the shading normal is
+/// the geometric one and front_face says whether the ray arrives against it.
 ///
 /// The queries are defined below the class, not in it, so that a leaf's header can say
 /// `extern template class detail::LeafShape<Leaf>;` and its source instantiate them where
@@ -36,6 +50,7 @@ class LeafShape : public Shape {
 public:
     bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
     bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
+    Hit finish(const Ray& ray, const HitRecord& record) const final;
 };
 
 template <class Derived>
@@ -56,6 +71,21 @@ template <class Derived>
 bool LeafShape<Derived>::any_hit(const Ray& ray, QueryScratch& scratch) const {
     count_solve(scratch, *this);
     return static_cast<const Derived&>(*this).crossing(ray).has_value();
+}
+
+template <class Derived>
+Hit LeafShape<Derived>::finish(const Ray& ray, const HitRecord& record) const {
+    const SurfacePoint surface = static_cast<const Derived&>(*this).surface_at(ray, record);
+    Hit hit;
+    hit.t = record.t;
+    hit.point = surface.point;
+    hit.geometric_normal = surface.normal;
+    hit.shading_normal = surface.normal;
+    hit.uv = surface.uv;
+    hit.shape = this;
+    hit.primitive_id = record.primitive;
+    hit.front_face = ray.direction.dot(surface.normal) < 0.0;
+    return hit;
 }
 
 }  // namespace detail

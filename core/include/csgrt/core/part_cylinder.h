@@ -26,7 +26,8 @@ public:
     /// The box of the arc (not of the whole cylinder), padded by a few ulps of the radius.
     Aabb bounds() const override { return bounds_; }
 
-    Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// Where the hit of a record `crossing` made lies, its normal and uv (LeafShape::finish).
+    SurfacePoint surface_at(const Ray& ray, const HitRecord& record) const;
     /// The nearest point in [t_min, t_max] where the ray crosses the kept part of the side.
     std::optional<Crossing> crossing(const Ray& ray) const;
 

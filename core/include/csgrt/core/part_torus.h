@@ -30,7 +30,8 @@ public:
     /// ulps of R + r.
     Aabb bounds() const override { return bounds_; }
 
-    Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// Where the hit of a record `crossing` made lies, its normal and uv (LeafShape::finish).
+    SurfacePoint surface_at(const Ray& ray, const HitRecord& record) const;
     /// The nearest root in [t_min, t_max] whose surface point the angle limits keep.
     std::optional<Crossing> crossing(const Ray& ray) const;
 

@@ -18,7 +18,8 @@ public:
     std::string_view kind() const override { return "rectangle"; }
     Aabb bounds() const override;
 
-    Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// Where the hit of a record `crossing` made lies, its normal and uv (LeafShape::finish).
+    SurfacePoint surface_at(const Ray& ray, const HitRecord& record) const;
 
     const Point3& corner() const { return corner_; }
     const Vector3& edge_a() const { return edge_a_; }

@@ -37,7 +37,8 @@ public:
 
     void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
     bool contains(const Point3& p) const override;
-    Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// Where the hit of a record `crossing` made lies, its normal and uv (LeafShape::finish).
+    SurfacePoint surface_at(const Ray& ray, const HitRecord& record) const;
     /// The nearest root of the ray's line with the torus in [t_min, t_max], if any.
     std::optional<Crossing> crossing(const Ray& ray) const;
 

@@ -24,7 +24,8 @@ public:
     std::string_view kind() const override { return "triangle"; }
     Aabb bounds() const override;
 
-    Hit finish(const Ray& ray, const HitRecord& record) const override;
+    /// Where the hit of a record `crossing` made lies, its normal and uv (LeafShape::finish).
+    SurfacePoint surface_at(const Ray& ray, const HitRecord& record) const;
 
     const Point3& vertex(int i) const { return vertices_[i]; }
     /// The unit normal.
