@@ -1,6 +1,7 @@
 #pragma once
 
-// Build and traversal machinery shared by the regular and the hierarchical grid (private to
+// Build and traversal machinery shared by the regular and the hierarchical grid: padding,
+// cell assignment, the cell walk, and the three queries as visitors of that walk (private to
 // accel/src).
 
 #include <Eigen/Geometry>
@@ -10,10 +11,11 @@
 #include <cstdint>
 #include <cstring>
 #include <span>
-#include <type_traits>
 #include <vector>
 
+#include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/regular_grid.h"
+#include "csgrt/accel/shape_set.h"
 
 namespace csgrt::detail {
 
@@ -378,17 +380,6 @@ inline void walk_cells(const GridGeometry& grid, const Ray& ray, const Vector3& 
     walk_cells(grid, ray, inverse_direction, t_enter, t_exit, visit, [](std::size_t) { return 0; });
 }
 
-/// The set member a record belongs to: shape sets name it in `object`, triangle sets in
-/// `primitive`.
-template <class Set>
-std::uint32_t member_of(const HitRecord& record) {
-    if constexpr (std::is_same_v<Set, ShapeSet>) {
-        return record.object;
-    } else {
-        return record.primitive;
-    }
-}
-
 /// Removes from hits[first ..] the records of members recorded more than once. The hashed
 /// mailbox forgets a primitive whose slot another one took, so all_hits may test (and record)
 /// it again; its records are identical, and sorting by member drops the copies exactly.
@@ -403,6 +394,126 @@ void drop_repeated_hits(std::vector<HitRecord>& hits, std::size_t first) {
                                return member_of<Set>(a) == member_of<Set>(b);
                            }),
                hits.end());
+}
+
+/// What a grid's walk does with the primitives it reaches, for one query kind (Derived:
+/// NearestCells, AnyCells, AllCells). `leaf(list)` tests a cell's primitives not seen in an
+/// earlier cell (the mailbox), `test(primitive)` tests one, and both return true to end the
+/// walk; `done(cell_exit)` says whether the walk may end after a cell that ends there;
+/// count_box and count_cell count the walk's boxes and cells when kCount.
+template <class Derived, class Set, bool kCount>
+class CellVisitor {
+public:
+    CellVisitor(const Set& set, const typename Set::PreparedRay& prepared,
+                TraversalCounters& counters)
+        : set_(set), prepared_(prepared), counters_(counters) {}
+
+    void count_box() {
+        if constexpr (kCount) ++counters_.boxes_tested;
+    }
+    void count_cell() {
+        if constexpr (kCount) ++counters_.nodes_visited;
+    }
+    bool test(std::uint32_t primitive) {
+        if constexpr (kCount) ++counters_.primitives_tested;
+        return static_cast<Derived&>(*this).test_uncounted(primitive);
+    }
+    bool leaf(std::span<const std::uint32_t> list) {
+        prefetch_primitives(set_, list.data(), list.data() + list.size());
+        for (const std::uint32_t primitive : list) {
+            if (mailbox_.first_visit(primitive) && test(primitive)) return true;
+        }
+        return false;
+    }
+
+protected:
+    const Set& set_;
+    const typename Set::PreparedRay& prepared_;
+
+private:
+    TraversalCounters& counters_;
+    Mailbox mailbox_;
+};
+
+/// Nearest hit: a hit beyond the current cell's exit is kept, not accepted (a primitive in a
+/// later cell may be nearer), and the walk ends after the first cell (at any level) that
+/// ends beyond the best hit by the stop rule's margin.
+template <class Set, bool kCount>
+class NearestCells : public CellVisitor<NearestCells<Set, kCount>, Set, kCount> {
+public:
+    NearestCells(const Set& set, const typename Set::PreparedRay& prepared, const Ray& ray,
+                 double scene_scale, TraversalCounters& counters)
+        : CellVisitor<NearestCells, Set, kCount>(set, prepared, counters), stop_(ray, scene_scale) {
+        best.t = ray.t_max;
+    }
+    bool test_uncounted(std::uint32_t primitive) {
+        found |= this->set_.intersect(primitive, this->prepared_, best);
+        return false;
+    }
+    bool done(double cell_exit) const { return found && stop_.done(best.t, cell_exit); }
+
+    HitRecord best;
+    bool found = false;
+
+private:
+    StopRule stop_;
+};
+
+/// Occlusion: the first hit anywhere in the interval ends the walk.
+template <class Set, bool kCount>
+class AnyCells : public CellVisitor<AnyCells<Set, kCount>, Set, kCount> {
+public:
+    using CellVisitor<AnyCells, Set, kCount>::CellVisitor;
+    bool test_uncounted(std::uint32_t primitive) {
+        return this->set_.occluded(primitive, this->prepared_);
+    }
+    bool done(double) const { return false; }
+};
+
+/// Every hit in the interval: the whole ray is walked, each hit appended to `hits`.
+template <class Set, bool kCount>
+class AllCells : public CellVisitor<AllCells<Set, kCount>, Set, kCount> {
+public:
+    AllCells(const Set& set, const typename Set::PreparedRay& prepared, double t_max,
+             std::vector<HitRecord>& hits, TraversalCounters& counters)
+        : CellVisitor<AllCells, Set, kCount>(set, prepared, counters), t_max_(t_max), hits_(hits) {}
+    bool test_uncounted(std::uint32_t primitive) {
+        HitRecord record;
+        record.t = t_max_;
+        if (this->set_.intersect(primitive, this->prepared_, record)) hits_.push_back(record);
+        return false;
+    }
+    bool done(double) const { return false; }
+
+private:
+    double t_max_;
+    std::vector<HitRecord>& hits_;
+};
+
+/// A grid's answer to a query of kind kKind over `set` (null before the grid is built): the
+/// visitor of that kind handed to `walk(visitor)`, the grid's own walk of its unbounded
+/// primitives and cells, which returns true when the visitor ended it. Returns whether the
+/// query found something, as AcceleratorBase expects; a nearest record is written only then.
+template <QueryKind kKind, bool kCount, class Set, class Walk>
+bool grid_query(const Set* set, double scene_scale, const Ray& ray, QueryAnswer<kKind>& answer,
+                QueryScratch& scratch, TraversalCounters& counters, Walk&& walk) {
+    if (set == nullptr || !is_valid(ray)) return false;
+    const auto prepared = set->prepare(ray, scratch);
+    if constexpr (kKind == QueryKind::kNearest) {
+        NearestCells<Set, kCount> visitor(*set, prepared, ray, scene_scale, counters);
+        walk(visitor);
+        if (visitor.found) answer = visitor.best;
+        return visitor.found;
+    } else if constexpr (kKind == QueryKind::kAny) {
+        AnyCells<Set, kCount> visitor(*set, prepared, counters);
+        return walk(visitor);
+    } else {
+        const std::size_t first = answer.size();
+        AllCells<Set, kCount> visitor(*set, prepared, ray.t_max, answer, counters);
+        walk(visitor);
+        drop_repeated_hits<Set>(answer, first);
+        return answer.size() > first;
+    }
 }
 
 }  // namespace csgrt::detail

@@ -6,7 +6,6 @@
 #include <sstream>
 
 #include "accelerator_base.h"
-#include "split_query.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
@@ -53,106 +52,6 @@ bool sub_grid_pays(const detail::GridGeometry& geometry, const std::vector<std::
         return false;
     return cost < double(count);
 }
-
-/// Nearest-hit search: a hit beyond the current cell's exit is kept, not accepted, and the
-/// walk ends after the first cell (at any level) that ends beyond the best hit.
-template <class Set, bool kCount>
-struct NearestVisitor {
-    NearestVisitor(const Set& set, const typename Set::PreparedRay& prepared, const Ray& ray,
-                   double scene_scale, TraversalCounters& counters)
-        : set(set), prepared(prepared), stop(ray, scene_scale), counters(counters) {
-        best.t = ray.t_max;
-    }
-
-    const Set& set;
-    const typename Set::PreparedRay& prepared;
-    detail::StopRule stop;
-    TraversalCounters& counters;
-    HitRecord best;
-    bool found = false;
-    detail::Mailbox mailbox;
-
-    void count_box() {
-        if constexpr (kCount) ++counters.boxes_tested;
-    }
-    void count_cell() {
-        if constexpr (kCount) ++counters.nodes_visited;
-    }
-    bool leaf(std::span<const std::uint32_t> list) {
-        detail::prefetch_primitives(set, list.data(), list.data() + list.size());
-        for (const std::uint32_t primitive : list) {
-            if (!mailbox.first_visit(primitive)) continue;
-            if constexpr (kCount) ++counters.primitives_tested;
-            found |= set.intersect(primitive, prepared, best);
-        }
-        return false;
-    }
-    bool done(double cell_exit) const { return found && stop.done(best.t, cell_exit); }
-};
-
-/// Occlusion: the first hit anywhere in the interval ends the walk.
-template <class Set, bool kCount>
-struct AnyVisitor {
-    AnyVisitor(const Set& set, const typename Set::PreparedRay& prepared,
-               TraversalCounters& counters)
-        : set(set), prepared(prepared), counters(counters) {}
-
-    const Set& set;
-    const typename Set::PreparedRay& prepared;
-    TraversalCounters& counters;
-    detail::Mailbox mailbox;
-
-    void count_box() {
-        if constexpr (kCount) ++counters.boxes_tested;
-    }
-    void count_cell() {
-        if constexpr (kCount) ++counters.nodes_visited;
-    }
-    bool leaf(std::span<const std::uint32_t> list) {
-        detail::prefetch_primitives(set, list.data(), list.data() + list.size());
-        for (const std::uint32_t primitive : list) {
-            if (!mailbox.first_visit(primitive)) continue;
-            if constexpr (kCount) ++counters.primitives_tested;
-            if (set.occluded(primitive, prepared)) return true;
-        }
-        return false;
-    }
-    bool done(double) const { return false; }
-};
-
-/// Every hit in the interval: the whole ray is walked.
-template <class Set, bool kCount>
-struct AllVisitor {
-    AllVisitor(const Set& set, const typename Set::PreparedRay& prepared, double t_max,
-               std::vector<HitRecord>& hits, TraversalCounters& counters)
-        : set(set), prepared(prepared), t_max(t_max), hits(hits), counters(counters) {}
-
-    const Set& set;
-    const typename Set::PreparedRay& prepared;
-    double t_max;
-    std::vector<HitRecord>& hits;
-    TraversalCounters& counters;
-    detail::Mailbox mailbox;
-
-    void count_box() {
-        if constexpr (kCount) ++counters.boxes_tested;
-    }
-    void count_cell() {
-        if constexpr (kCount) ++counters.nodes_visited;
-    }
-    bool leaf(std::span<const std::uint32_t> list) {
-        detail::prefetch_primitives(set, list.data(), list.data() + list.size());
-        for (const std::uint32_t primitive : list) {
-            if (!mailbox.first_visit(primitive)) continue;
-            if constexpr (kCount) ++counters.primitives_tested;
-            HitRecord record;
-            record.t = t_max;
-            if (set.intersect(primitive, prepared, record)) hits.push_back(record);
-        }
-        return false;
-    }
-    bool done(double) const { return false; }
-};
 
 }  // namespace
 
@@ -316,48 +215,18 @@ bool HierarchicalGrid<Set>::traverse(std::uint32_t grid_index, const Ray& ray,
 }
 
 template <class Set>
-template <QueryKind kKind, bool kCounted>
-bool HierarchicalGrid<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
-                                  TraversalCounters& counters) const {
-    return detail::SplitQuery::query<kKind, kCounted>(*this, ray, answer, scratch, counters);
-}
-
-template <class Set>
-template <bool kCount>
-bool HierarchicalGrid<Set>::intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                                           TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return false;
-    const auto prepared = set_->prepare(ray, scratch);
-    NearestVisitor<Set, kCount> visitor(*set_, prepared, ray, scene_scale_, counters);
-    visitor.leaf(unbounded_);
-    if (!grids_.empty()) traverse(0, ray, ray.direction.cwiseInverse(), visitor);
-    if (visitor.found) record = visitor.best;
-    return visitor.found;
-}
-
-template <class Set>
-template <bool kCount>
-bool HierarchicalGrid<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
-                                          TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return false;
-    const auto prepared = set_->prepare(ray, scratch);
-    AnyVisitor<Set, kCount> visitor(*set_, prepared, counters);
+template <class Visitor>
+bool HierarchicalGrid<Set>::walk(const Ray& ray, Visitor& visitor) const {
     if (visitor.leaf(unbounded_)) return true;
     return !grids_.empty() && traverse(0, ray, ray.direction.cwiseInverse(), visitor);
 }
 
 template <class Set>
-template <bool kCount>
-void HierarchicalGrid<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits,
-                                          QueryScratch& scratch,
-                                          TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return;
-    const auto prepared = set_->prepare(ray, scratch);
-    const std::size_t first = hits.size();
-    AllVisitor<Set, kCount> visitor(*set_, prepared, ray.t_max, hits, counters);
-    visitor.leaf(unbounded_);
-    if (!grids_.empty()) traverse(0, ray, ray.direction.cwiseInverse(), visitor);
-    detail::drop_repeated_hits<Set>(hits, first);
+template <QueryKind kKind, bool kCounted>
+bool HierarchicalGrid<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+                                  TraversalCounters& counters) const {
+    return detail::grid_query<kKind, kCounted>(set_, scene_scale_, ray, answer, scratch, counters,
+                                               [&](auto& visitor) { return walk(ray, visitor); });
 }
 
 template class HierarchicalGrid<TriangleSet<float>>;

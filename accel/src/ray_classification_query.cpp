@@ -12,7 +12,6 @@
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "ray_classification_node.h"
-#include "split_query.h"
 
 namespace csgrt {
 
@@ -178,7 +177,28 @@ template <class Set>
 template <QueryKind kKind, bool kCounted>
 bool RayClassification<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer,
                                    QueryScratch& scratch, TraversalCounters& counters) const {
-    return detail::SplitQuery::query<kKind, kCounted>(*this, ray, answer, scratch, counters);
+    if constexpr (kKind == QueryKind::kNearest) {
+        return intersect_impl<kCounted>(ray, answer, scratch, counters);
+    } else {
+        if (set_ == nullptr || !is_valid(ray)) return false;
+        const auto prepared = set_->prepare(ray, scratch);
+        if constexpr (kKind == QueryKind::kAny) {
+            return visit_candidates<kCounted>(ray, counters, [&](std::uint32_t index) {
+                if constexpr (kCounted) ++counters.primitives_tested;
+                return set_->occluded(index, prepared);
+            });
+        } else {
+            const std::size_t before = answer.size();
+            visit_candidates<kCounted>(ray, counters, [&](std::uint32_t index) {
+                if constexpr (kCounted) ++counters.primitives_tested;
+                HitRecord hit;
+                hit.t = ray.t_max;
+                if (set_->intersect(index, prepared, hit)) answer.push_back(hit);
+                return false;
+            });
+            return answer.size() > before;
+        }
+    }
 }
 
 template <class Set>
@@ -264,26 +284,24 @@ bool RayClassification<Set>::intersect_impl(const Ray& ray, HitRecord& record,
 }
 
 template <class Set>
-template <bool kCount>
-bool RayClassification<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
-                                           TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return false;
+template <bool kCount, class Visit>
+bool RayClassification<Set>::visit_candidates(const Ray& ray, TraversalCounters& counters,
+                                              Visit&& visit) const {
     TraversalCounters local;
     const Search search = find_candidates(ray, local);
     if constexpr (kCount) {
         counters.nodes_visited += local.nodes_visited;
         counters.boxes_tested += local.boxes_tested;
     }
-    const auto prepared = set_->prepare(ray, scratch);
     if (search.far) {
         for (std::uint32_t index : bounded_) {
-            if constexpr (kCount) ++counters.primitives_tested;
-            if (set_->occluded(index, prepared)) return true;
+            if (visit(index)) return true;
         }
     }
     const double stop = stop_position(search.w_origin, search.w_speed, ray.t_max);
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     std::uint32_t stack[kStackSize];
+    // A cell's clusters are disjoint subtrees, so each primitive is reached at most once.
     for (std::uint32_t k = 0; k < search.count; ++k) {
         const Candidate candidate = search.candidates[k];
         if (candidate.key > stop) break;
@@ -295,8 +313,7 @@ bool RayClassification<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch
             if (!hits_box(node, ray.origin, inverse_direction, ray.t_min, ray.t_max)) continue;
             if (node.is_leaf()) {
                 for (std::uint32_t j = node.offset; j < node.offset + node.count; ++j) {
-                    if constexpr (kCount) ++counters.primitives_tested;
-                    if (set_->occluded(cluster_primitives_[j], prepared)) return true;
+                    if (visit(cluster_primitives_[j])) return true;
                 }
                 continue;
             }
@@ -305,54 +322,9 @@ bool RayClassification<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch
         }
     }
     for (std::uint32_t index : unbounded_) {
-        if constexpr (kCount) ++counters.primitives_tested;
-        if (set_->occluded(index, prepared)) return true;
+        if (visit(index)) return true;
     }
     return false;
-}
-
-template <class Set>
-template <bool kCount>
-void RayClassification<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits,
-                                           QueryScratch& scratch,
-                                           TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return;
-    TraversalCounters local;
-    const Search search = find_candidates(ray, local);
-    if constexpr (kCount) {
-        counters.nodes_visited += local.nodes_visited;
-        counters.boxes_tested += local.boxes_tested;
-    }
-    const auto prepared = set_->prepare(ray, scratch);
-    auto collect = [&](std::uint32_t index) {
-        if constexpr (kCount) ++counters.primitives_tested;
-        HitRecord hit;
-        hit.t = ray.t_max;
-        if (set_->intersect(index, prepared, hit)) hits.push_back(hit);
-    };
-    if (search.far)
-        for (std::uint32_t index : bounded_) collect(index);
-    const double stop = stop_position(search.w_origin, search.w_speed, ray.t_max);
-    const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    std::uint32_t stack[kStackSize];
-    // A cell's clusters are disjoint subtrees, so each primitive is reported at most once.
-    for (std::uint32_t k = 0; k < search.count && !(search.candidates[k].key > stop); ++k) {
-        int top = 0;
-        stack[top++] = search.candidates[k].cluster;
-        while (top > 0) {
-            const BvhNode& node = clusters_[stack[--top]];
-            if constexpr (kCount) ++counters.boxes_tested;
-            if (!hits_box(node, ray.origin, inverse_direction, ray.t_min, ray.t_max)) continue;
-            if (node.is_leaf()) {
-                for (std::uint32_t j = node.offset; j < node.offset + node.count; ++j)
-                    collect(cluster_primitives_[j]);
-                continue;
-            }
-            stack[top++] = node.offset;
-            stack[top++] = node.offset + 1;
-        }
-    }
-    for (std::uint32_t index : unbounded_) collect(index);
 }
 
 // The members defined here, which the header's extern template leaves to this source.

@@ -6,7 +6,6 @@
 #include <sstream>
 
 #include "accelerator_base.h"
-#include "split_query.h"
 #include "csgrt/accel/shape_set.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
@@ -194,128 +193,38 @@ std::span<const std::uint32_t> RegularGrid<Set>::cell_primitives(int x, int y, i
 }
 
 template <class Set>
-template <QueryKind kKind, bool kCounted>
-bool RegularGrid<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
-                             TraversalCounters& counters) const {
-    return detail::SplitQuery::query<kKind, kCounted>(*this, ray, answer, scratch, counters);
-}
-
-template <class Set>
-template <bool kCount>
-bool RegularGrid<Set>::intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                                      TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return false;
-    const auto prepared = set_->prepare(ray, scratch);
-    HitRecord best;
-    best.t = ray.t_max;
-    bool found = false;
+template <class Visitor>
+bool RegularGrid<Set>::walk(const Ray& ray, Visitor& visitor) const {
+    // Every ray tests the unbounded primitives; no cell lists them, so no mailbox is needed.
     for (const std::uint32_t primitive : unbounded_) {
-        if constexpr (kCount) ++counters.primitives_tested;
-        found |= set_->intersect(primitive, prepared, best);
+        if (visitor.test(primitive)) return true;
     }
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     double t_enter, t_exit;
-    if constexpr (kCount) ++counters.boxes_tested;
-    if (!primitives_.empty() &&
-        detail::clip_to_box(geometry_.bounds, ray, inverse_direction, t_enter, t_exit)) {
-        const detail::StopRule stop(ray, scene_scale_);
-        detail::Mailbox mailbox;
-        // A hit beyond the current cell's exit is kept, not accepted: a primitive in a later
-        // cell may be nearer. The search ends after the first cell that ends beyond the best.
-        detail::walk_cells(
-            geometry_, ray, inverse_direction, t_enter, t_exit,
-            [&](std::size_t cell, double cell_exit) {
-                if constexpr (kCount) ++counters.nodes_visited;
-                if (!is_occupied(cell)) return false;
-                const std::uint32_t end = offsets_[cell + 1];
-                detail::prefetch_primitives(*set_, &primitives_[offsets_[cell]],
-                                            primitives_.data() + end);
-                for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
-                    const std::uint32_t primitive = primitives_[k];
-                    if (!mailbox.first_visit(primitive)) continue;
-                    if constexpr (kCount) ++counters.primitives_tested;
-                    found |= set_->intersect(primitive, prepared, best);
-                }
-                return found && stop.done(best.t, cell_exit);
-            },
-            [&](std::size_t cell) { return int(empty_radius_[cell]); });
-    }
-    if (found) record = best;
-    return found;
-}
-
-template <class Set>
-template <bool kCount>
-bool RegularGrid<Set>::occluded_impl(const Ray& ray, QueryScratch& scratch,
-                                     TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return false;
-    const auto prepared = set_->prepare(ray, scratch);
-    for (const std::uint32_t primitive : unbounded_) {
-        if constexpr (kCount) ++counters.primitives_tested;
-        if (set_->occluded(primitive, prepared)) return true;
-    }
-    const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    double t_enter, t_exit;
-    if constexpr (kCount) ++counters.boxes_tested;
+    visitor.count_box();
     if (primitives_.empty() ||
         !detail::clip_to_box(geometry_.bounds, ray, inverse_direction, t_enter, t_exit))
         return false;
-    detail::Mailbox mailbox;
-    bool hit = false;
+    bool stop = false;
     detail::walk_cells(
         geometry_, ray, inverse_direction, t_enter, t_exit,
-        [&](std::size_t cell, double) {
-            if constexpr (kCount) ++counters.nodes_visited;
+        [&](std::size_t cell, double cell_exit) {
+            visitor.count_cell();
             if (!is_occupied(cell)) return false;
-            const std::uint32_t end = offsets_[cell + 1];
-            detail::prefetch_primitives(*set_, &primitives_[offsets_[cell]],
-                                        primitives_.data() + end);
-            for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
-                const std::uint32_t primitive = primitives_[k];
-                if (!mailbox.first_visit(primitive)) continue;
-                if constexpr (kCount) ++counters.primitives_tested;
-                if (set_->occluded(primitive, prepared)) return hit = true;
-            }
-            return false;
+            const std::span<const std::uint32_t> list(primitives_.data() + offsets_[cell],
+                                                      offsets_[cell + 1] - offsets_[cell]);
+            return stop = visitor.leaf(list) || visitor.done(cell_exit);
         },
         [&](std::size_t cell) { return int(empty_radius_[cell]); });
-    return hit;
+    return stop;
 }
 
 template <class Set>
-template <bool kCount>
-void RegularGrid<Set>::all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits,
-                                     QueryScratch& scratch, TraversalCounters& counters) const {
-    if (set_ == nullptr || !is_valid(ray)) return;
-    const auto prepared = set_->prepare(ray, scratch);
-    const std::size_t first = hits.size();
-    auto test = [&](std::uint32_t primitive) {
-        if constexpr (kCount) ++counters.primitives_tested;
-        HitRecord record;
-        record.t = ray.t_max;
-        if (set_->intersect(primitive, prepared, record)) hits.push_back(record);
-    };
-    for (const std::uint32_t primitive : unbounded_) test(primitive);
-    const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    double t_enter, t_exit;
-    if constexpr (kCount) ++counters.boxes_tested;
-    if (!primitives_.empty() &&
-        detail::clip_to_box(geometry_.bounds, ray, inverse_direction, t_enter, t_exit)) {
-        detail::Mailbox mailbox;
-        detail::walk_cells(
-            geometry_, ray, inverse_direction, t_enter, t_exit,
-            [&](std::size_t cell, double) {
-                if constexpr (kCount) ++counters.nodes_visited;
-                if (!is_occupied(cell)) return false;
-                const std::uint32_t end = offsets_[cell + 1];
-                for (std::uint32_t k = offsets_[cell]; k < end; ++k) {
-                    if (mailbox.first_visit(primitives_[k])) test(primitives_[k]);
-                }
-                return false;
-            },
-            [&](std::size_t cell) { return int(empty_radius_[cell]); });
-    }
-    detail::drop_repeated_hits<Set>(hits, first);
+template <QueryKind kKind, bool kCounted>
+bool RegularGrid<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+                             TraversalCounters& counters) const {
+    return detail::grid_query<kKind, kCounted>(set_, scene_scale_, ray, answer, scratch, counters,
+                                               [&](auto& visitor) { return walk(ray, visitor); });
 }
 
 template class RegularGrid<TriangleSet<float>>;

@@ -110,16 +110,6 @@ struct Answer {
     HitRecord record;
 };
 
-/// The set member a record names: triangle sets write `primitive`, shape sets `object`.
-template <class Set>
-std::uint32_t member_of(const HitRecord& record) {
-    if constexpr (std::is_same_v<Set, ShapeSet>) {
-        return record.object;
-    } else {
-        return record.primitive;
-    }
-}
-
 /// The records' (member, t) pairs, sorted: all_hits compared as sets.
 template <class Set>
 std::vector<std::tuple<std::uint32_t, double, float, float>> hit_set(

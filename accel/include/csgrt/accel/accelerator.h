@@ -13,6 +13,13 @@
 
 namespace csgrt {
 
+/// The three primitive sets every structure is built for (accel/shape_set.h,
+/// accel/triangle_set.h): each structure's header declares its instantiations over them
+/// `extern template`, and its source defines them.
+class ShapeSet;
+template <class Real>
+class TriangleSet;
+
 /// Per-ray work, accumulated over the rays of a counted query.
 struct TraversalCounters {
     /// Tree nodes, grid cells or ray-space cells visited.

@@ -32,9 +32,6 @@ private:
     using AcceleratorBase<BruteForce<Set>, Set>::stats_;
 };
 
-class ShapeSet;
-template <class Real>
-class TriangleSet;
 extern template class BruteForce<TriangleSet<float>>;
 extern template class BruteForce<TriangleSet<double>>;
 extern template class BruteForce<ShapeSet>;

@@ -10,10 +10,6 @@
 
 namespace csgrt {
 
-namespace detail {
-struct SplitQuery;  // accel/src/split_query.h: the dispatch to the three walks below
-}  // namespace detail
-
 /// A hierarchy of uniform grids after Jevans & Wyvill, "Adaptive Voxel Subdivision for Ray
 /// Tracing", Graphics Interface 1989: a coarse top grid (N^0.6 cells, Ize et al. 2007) whose
 /// crowded cells hold grids of their own, recursively. Unlike Klimaszewski & Sederberg, "Faster
@@ -71,15 +67,9 @@ private:
     template <class Visitor>
     bool traverse(std::uint32_t grid, const Ray& ray, const Vector3& inverse_direction,
                   Visitor& visitor) const;
-    friend struct detail::SplitQuery;
-    template <bool kCount>
-    bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                        TraversalCounters& counters) const;
-    template <bool kCount>
-    bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
-    template <bool kCount>
-    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch,
-                       TraversalCounters& counters) const;
+    /// The unbounded primitives, then the grids along the ray (detail::grid_query's walk).
+    template <class Visitor>
+    bool walk(const Ray& ray, Visitor& visitor) const;
     using AcceleratorBase<HierarchicalGrid<Set>, Set>::stats_;
 
     const Set* set_ = nullptr;
@@ -92,9 +82,6 @@ private:
     std::vector<std::uint32_t> unbounded_;
 };
 
-class ShapeSet;
-template <class Real>
-class TriangleSet;
 extern template class HierarchicalGrid<TriangleSet<float>>;
 extern template class HierarchicalGrid<TriangleSet<double>>;
 extern template class HierarchicalGrid<ShapeSet>;

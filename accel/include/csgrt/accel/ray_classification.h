@@ -20,8 +20,6 @@ namespace csgrt {
 
 namespace detail {
 
-struct SplitQuery;  // accel/src/split_query.h: the dispatch to the three walks below
-
 /// The face of the direction cube a direction points through, and its coordinates on it: the
 /// dominant axis a = argmax |d_i| (ties go to the lower axis), the sign of d_a, and
 /// u = d_b / |d_a|, v = d_c / |d_a| in [-1, 1], with b = a+1, c = a+2 (mod 3).
@@ -190,15 +188,17 @@ private:
     int split_axis(int face, int depth, const double lower[5], const double upper[5]) const;
     void root_cell(double lower[5], double upper[5]) const;
     bool is_final(const Node& node, int depth) const;
-    friend struct detail::SplitQuery;
+    /// The nearest hit: candidate clusters in order along the ray, nearer halves first, each
+    /// box tested against the best hit so far.
     template <bool kCount>
     bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
                         TraversalCounters& counters) const;
-    template <bool kCount>
-    bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
-    template <bool kCount>
-    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch,
-                       TraversalCounters& counters) const;
+    /// Calls visit(primitive) for every primitive a ray may hit in [t_min, t_max], in no
+    /// particular order (occlusion and every hit): the bounded ones when the ray is too far
+    /// for the padding, the leaves of the candidate clusters whose boxes it enters, the
+    /// unbounded ones. Stops when visit returns true, and then returns true.
+    template <bool kCount, class Visit>
+    bool visit_candidates(const Ray& ray, TraversalCounters& counters, Visit&& visit) const;
 
     const Set* set_ = nullptr;
     RayClassificationConfig config_;
@@ -232,9 +232,6 @@ private:
     std::uint64_t build_id_ = 0;
 };
 
-class ShapeSet;
-template <class Real>
-class TriangleSet;
 extern template class RayClassification<TriangleSet<float>>;
 extern template class RayClassification<TriangleSet<double>>;
 extern template class RayClassification<ShapeSet>;

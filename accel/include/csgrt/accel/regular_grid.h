@@ -13,8 +13,6 @@ namespace csgrt {
 
 namespace detail {
 
-struct SplitQuery;  // accel/src/split_query.h: the dispatch to the three walks below
-
 /// The cells of one uniform grid: a box cut into resolution[0] x resolution[1] x resolution[2]
 /// equal cells, numbered x fastest. Cell (i, j, k) spans lower + (i, j, k) * cell_size to
 /// lower + (i + 1, j + 1, k + 1) * cell_size; the traversal and the build use these same
@@ -88,15 +86,9 @@ public:
     std::span<const std::uint32_t> unbounded_primitives() const { return unbounded_; }
 
 private:
-    friend struct detail::SplitQuery;
-    template <bool kCount>
-    bool intersect_impl(const Ray& ray, HitRecord& record, QueryScratch& scratch,
-                        TraversalCounters& counters) const;
-    template <bool kCount>
-    bool occluded_impl(const Ray& ray, QueryScratch& scratch, TraversalCounters& counters) const;
-    template <bool kCount>
-    void all_hits_impl(const Ray& ray, std::vector<HitRecord>& hits, QueryScratch& scratch,
-                       TraversalCounters& counters) const;
+    /// The unbounded primitives, then the cells along the ray (detail::grid_query's walk).
+    template <class Visitor>
+    bool walk(const Ray& ray, Visitor& visitor) const;
     using AcceleratorBase<RegularGrid<Set>, Set>::stats_;
     bool is_occupied(std::size_t cell) const { return (occupied_[cell / 64] >> (cell % 64)) & 1; }
 
@@ -117,9 +109,6 @@ private:
     std::vector<std::uint32_t> unbounded_;
 };
 
-class ShapeSet;
-template <class Real>
-class TriangleSet;
 extern template class RegularGrid<TriangleSet<float>>;
 extern template class RegularGrid<TriangleSet<double>>;
 extern template class RegularGrid<ShapeSet>;

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "csgrt/core/shape.h"
@@ -43,5 +45,16 @@ private:
     std::vector<std::shared_ptr<const Shape>> shapes_;
     std::vector<Aabb> bounds_;
 };
+
+/// The member of a set of type Set that a record of its names: a ShapeSet's hits carry it in
+/// `object`, a triangle set's in `primitive`.
+template <class Set>
+std::uint32_t member_of(const HitRecord& record) {
+    if constexpr (std::is_same_v<Set, ShapeSet>) {
+        return record.object;
+    } else {
+        return record.primitive;
+    }
+}
 
 }  // namespace csgrt
