@@ -95,7 +95,12 @@ bool Boolean::operand_spans(const Ray& ray, const Vector3& inverse_direction, Sp
     return operation_ == BooleanOperation::Difference || !second_spans.empty();
 }
 
-bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
+template <bool kAny>
+bool Boolean::first_boundary(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
+    // An operand's own answer: its nearest hit, or (kAny) whether it is hit at all.
+    const auto operand_hit = [&](const Shape& operand) {
+        return kAny ? operand.any_hit(ray, scratch) : operand.nearest_hit(ray, record, scratch);
+    };
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
     count_box_tests(scratch, 1);
     if (!box_hit(bounds_, bounds_empty_, ray, inverse_direction)) return false;
@@ -108,18 +113,15 @@ bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scrat
         const bool second_hit =
             box_interval(second_bounds_, second_empty_, ray, inverse_direction, second_t0,
                          second_t1);
-        if (!second_hit) return first_hit && first_->nearest_hit(ray, record, scratch);
-        if (!first_hit) return second_->nearest_hit(ray, record, scratch);
+        if (!second_hit) return first_hit && operand_hit(*first_);
+        if (!first_hit) return operand_hit(*second_);
         // Operands whose boxes the ray crosses one after the other cannot overlap or touch
-        // along it, so the union's first end is the nearer operand's first end.
-        if (first_t1 < second_t0) {
-            return first_->nearest_hit(ray, record, scratch) ||
-                   second_->nearest_hit(ray, record, scratch);
+        // along it, so the union's first end is the nearer operand's first end (and any hit
+        // of either is a hit of the union).
+        if (first_t1 < second_t0 || (kAny && second_t1 < first_t0)) {
+            return operand_hit(*first_) || operand_hit(*second_);
         }
-        if (second_t1 < first_t0) {
-            return second_->nearest_hit(ray, record, scratch) ||
-                   first_->nearest_hit(ray, record, scratch);
-        }
+        if (second_t1 < first_t0) return operand_hit(*second_) || operand_hit(*first_);
         BorrowedSpans first_spans(scratch);
         BorrowedSpans second_spans(scratch);
         first_->find_spans(ray, first_spans.list(), scratch);
@@ -130,7 +132,7 @@ bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scrat
     if (operation_ == BooleanOperation::Difference) count_box_tests(scratch, 1);
     if (operation_ == BooleanOperation::Difference &&
         !box_hit(second_bounds_, second_empty_, ray, inverse_direction)) {
-        return first_->nearest_hit(ray, record, scratch);
+        return operand_hit(*first_);
     }
     BorrowedSpans first_spans(scratch);
     BorrowedSpans second_spans(scratch);
@@ -140,44 +142,13 @@ bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scrat
                                    coincidence_);
 }
 
+bool Boolean::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
+    return first_boundary<false>(ray, record, scratch);
+}
+
 bool Boolean::any_hit(const Ray& ray, QueryScratch& scratch) const {
-    const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    count_box_tests(scratch, 1);
-    if (!box_hit(bounds_, bounds_empty_, ray, inverse_direction)) return false;
     HitRecord record;
-    if (operation_ == BooleanOperation::Union) {
-        count_box_tests(scratch, 2);
-        double first_t0, first_t1, second_t0, second_t1;
-        const bool first_hit =
-            box_interval(first_bounds_, first_empty_, ray, inverse_direction, first_t0,
-                         first_t1);
-        const bool second_hit =
-            box_interval(second_bounds_, second_empty_, ray, inverse_direction, second_t0,
-                         second_t1);
-        if (!second_hit) return first_hit && first_->any_hit(ray, scratch);
-        if (!first_hit) return second_->any_hit(ray, scratch);
-        // Disjoint along the ray: every operand end is an end of the union.
-        if (first_t1 < second_t0 || second_t1 < first_t0) {
-            return first_->any_hit(ray, scratch) || second_->any_hit(ray, scratch);
-        }
-        BorrowedSpans first_spans(scratch);
-        BorrowedSpans second_spans(scratch);
-        first_->find_spans(ray, first_spans.list(), scratch);
-        second_->find_spans(ray, second_spans.list(), scratch);
-        return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray,
-                                       record, coincidence_);
-    }
-    if (operation_ == BooleanOperation::Difference) count_box_tests(scratch, 1);
-    if (operation_ == BooleanOperation::Difference &&
-        !box_hit(second_bounds_, second_empty_, ray, inverse_direction)) {
-        return first_->any_hit(ray, scratch);
-    }
-    BorrowedSpans first_spans(scratch);
-    BorrowedSpans second_spans(scratch);
-    if (!operand_spans(ray, inverse_direction, first_spans.list(), second_spans.list(), scratch))
-        return false;
-    return first_combined_boundary(operation_, first_spans.list(), second_spans.list(), ray, record,
-                                   coincidence_);
+    return first_boundary<true>(ray, record, scratch);
 }
 
 void Boolean::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {

@@ -52,6 +52,12 @@ private:
     /// For intersection and difference: the first operand's spans in `first_spans`, and in
     /// `second_spans` the second operand's spans over the stretch the first one covers. False
     /// when the result is empty along `inside`.
+    /// nearest_hit (kAny false: the first boundary in [t_min, t_max] into `record`) and
+    /// any_hit (kAny true: whether there is one, `record` a scratch value), written once: the
+    /// same box tests, operand shortcuts and span combination in the same order.
+    template <bool kAny>
+    [[gnu::always_inline]] inline bool first_boundary(const Ray& ray, HitRecord& record,
+                                                      QueryScratch& scratch) const;
     bool operand_spans(const Ray& inside, const Vector3& inverse_direction, SpanList& first_spans,
                        SpanList& second_spans, QueryScratch& scratch) const;
 
