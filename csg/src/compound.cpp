@@ -44,6 +44,7 @@ Compound::Compound(std::vector<std::shared_ptr<const Shape>> children, const Com
         solid_ = solid_ && child->is_solid();
         bounds_.extend(child->bounds());
     }
+    coincidence_ = span_coincidence_relative(children_);
 }
 
 std::string_view Compound::accelerator_name() const {
@@ -119,7 +120,8 @@ void Compound::union_of_spans(const Ray& ray, SpanList& spans, QueryScratch& scr
             std::swap(spans, child_spans.list());
             continue;
         }
-        combine_spans(BooleanOperation::Union, spans, child_spans.list(), ray, combined.list());
+        combine_spans(BooleanOperation::Union, spans, child_spans.list(), ray, combined.list(),
+                      coincidence_);
         std::swap(spans, combined.list());
     }
 }

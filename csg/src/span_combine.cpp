@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "csgrt/mesh/mesh.h"
@@ -22,10 +23,9 @@ double coincidence_tolerance(double relative, double origin_over_direction, doub
     return relative * (std::abs(t) + origin_over_direction);
 }
 
-/// Whether a float Mesh lies anywhere beneath `root`; each shared shape is visited once, so a
-/// grid of copies of one definition costs one walk of it.
-bool holds_float_mesh(const Shape& root) {
-    std::vector<const Shape*> pending{&root};
+/// Whether a float Mesh lies anywhere beneath any of `roots`; each shared shape is visited
+/// once, so a grid of copies of one definition costs one walk of it.
+bool holds_float_mesh(std::vector<const Shape*> pending) {
     std::unordered_set<const Shape*> seen;
     while (!pending.empty()) {
         const Shape* shape = pending.back();
@@ -228,8 +228,14 @@ double span_coincidence_tolerance(const Ray& ray, double t, double relative) {
 }
 
 double span_coincidence_relative(const Shape& first, const Shape& second) {
-    return holds_float_mesh(first) || holds_float_mesh(second) ? kFloatSpanCoincidence
-                                                               : kDoubleSpanCoincidence;
+    return holds_float_mesh({&first, &second}) ? kFloatSpanCoincidence : kDoubleSpanCoincidence;
+}
+
+double span_coincidence_relative(std::span<const std::shared_ptr<const Shape>> shapes) {
+    std::vector<const Shape*> roots;
+    roots.reserve(shapes.size());
+    for (const auto& shape : shapes) roots.push_back(shape.get());
+    return holds_float_mesh(std::move(roots)) ? kFloatSpanCoincidence : kDoubleSpanCoincidence;
 }
 
 void combine_spans(BooleanOperation operation, const SpanList& first, const SpanList& second,

@@ -12,6 +12,7 @@
 #include "csgrt/accel/factory.h"
 #include "csgrt/core/shape.h"
 #include "csgrt/csg/shape_group.h"
+#include "csgrt/csg/span_combine.h"
 
 namespace csgrt {
 
@@ -54,7 +55,8 @@ public:
 
     bool nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const override;
     bool any_hit(const Ray& ray, QueryScratch& scratch) const override;
-    /// The union of the children's spans (combine_spans, so touching spans merge).
+    /// The union of the children's spans (combine_spans, so touching spans merge; within float
+    /// ulps when a child holds a float mesh).
     void find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const override;
     /// Whether any child contains p.
     bool contains(const Point3& p) const override;
@@ -84,6 +86,10 @@ private:
     ShapeGroup group_;
     Aabb bounds_;
     bool solid_ = false;
+    /// The children's span coincidence tolerance (span_coincidence_relative), chosen once:
+    /// float-sized when a child holds a float mesh, so a float mesh and a child touching it
+    /// unite without an internal surface, as they do under a Boolean.
+    double coincidence_ = kDoubleSpanCoincidence;
 };
 
 /// Groups `shapes` into a tree of nested compounds of at most `max_children` children each,

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <memory>
+#include <span>
+
 #include "csgrt/core/hit.h"
 #include "csgrt/core/ray.h"
 #include "csgrt/core/span.h"
@@ -45,6 +48,9 @@ double span_coincidence_tolerance(const Ray& ray, double t,
 /// double's otherwise. Walks the operands' trees once (shared members once); for building a
 /// node, never on a query's path.
 double span_coincidence_relative(const Shape& first, const Shape& second);
+/// The same for the members of a union whose spans are combined together (a Compound's
+/// children): float's when any of them holds a float Mesh beneath it.
+double span_coincidence_relative(std::span<const std::shared_ptr<const Shape>> shapes);
 
 /// Combines two operands' span lists along `ray` by `operation` into `result` (cleared first)
 /// as Roth's CombineSegs does ("Ray Casting for Modeling Solids", CGIP 18, 1982): the ends are
