@@ -37,8 +37,8 @@ std::vector<std::shared_ptr<const Shape>> checked_children(
 }  // namespace
 
 Compound::Compound(std::vector<std::shared_ptr<const Shape>> children, const CompoundConfig& config)
-    : children_(checked_children(std::move(children))),
-      group_(children_, config.accelerator, config.accelerator_config) {
+    : children_(checked_children(std::move(children))), config_(config) {
+    if (!config.build_at_commit) build_group(config.accelerator, config.accelerator_config);
     solid_ = !children_.empty();
     for (const auto& child : children_) {
         solid_ = solid_ && child->is_solid();
@@ -47,34 +47,56 @@ Compound::Compound(std::vector<std::shared_ptr<const Shape>> children, const Com
     coincidence_ = span_coincidence_relative(children_);
 }
 
+const ShapeGroup& Compound::build_group(std::string_view accelerator,
+                                        const AcceleratorConfig& config) const {
+    const std::lock_guard<std::mutex> lock(build_mutex_);
+    if (owned_group_ == nullptr) {
+        owned_group_ = std::make_unique<const ShapeGroup>(children_, accelerator, config);
+        group_.store(owned_group_.get(), std::memory_order_release);
+    }
+    return *owned_group_;
+}
+
+void Compound::build_at_commit(std::string_view accelerator,
+                               const AcceleratorConfig& config) const {
+    if (is_built()) return;
+    build_group(config_.accelerator == "auto" ? accelerator : std::string_view(config_.accelerator),
+                config);
+}
+
 std::string_view Compound::accelerator_name() const {
-    return group_.bounded().size() > 0 ? group_.accelerator_name() : std::string_view();
+    const ShapeGroup& members = group();
+    return members.bounded().size() > 0 ? members.accelerator_name() : std::string_view();
 }
 
 AcceleratorStats Compound::accelerator_stats() const {
-    return group_.bounded().size() > 0 ? group_.accelerator_stats() : AcceleratorStats{};
+    const ShapeGroup& members = group();
+    return members.bounded().size() > 0 ? members.accelerator_stats() : AcceleratorStats{};
 }
 
 bool Compound::nearest_hit(const Ray& ray, HitRecord& record, QueryScratch& scratch) const {
+    const ShapeGroup& members = group();
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    if (group_.unbounded().empty()) count_box_tests(scratch, 1);
-    if (group_.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
-    return group_.nearest(ray, record, scratch);
+    if (members.unbounded().empty()) count_box_tests(scratch, 1);
+    if (members.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
+    return members.nearest(ray, record, scratch);
 }
 
 bool Compound::any_hit(const Ray& ray, QueryScratch& scratch) const {
+    const ShapeGroup& members = group();
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    if (group_.unbounded().empty()) count_box_tests(scratch, 1);
-    if (group_.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
-    return group_.any(ray, scratch);
+    if (members.unbounded().empty()) count_box_tests(scratch, 1);
+    if (members.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return false;
+    return members.any(ray, scratch);
 }
 
 void Compound::find_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const {
     spans.clear();
     if (!solid_) return;
+    const ShapeGroup& members = group();
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    if (group_.unbounded().empty()) count_box_tests(scratch, 1);
-    if (group_.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return;
+    if (members.unbounded().empty()) count_box_tests(scratch, 1);
+    if (members.unbounded().empty() && !box_hit(bounds_, ray, inverse_direction)) return;
     union_of_spans(ray, spans, scratch);
 }
 
@@ -83,13 +105,14 @@ void Compound::union_of_spans(const Ray& ray, SpanList& spans, QueryScratch& scr
     // span ends always go to the lower index (combine_spans prefers its first operand).
     BorrowedHits candidates(scratch);
     std::vector<HitRecord>& list = candidates.list();
+    const ShapeGroup& members = group();
     const Vector3 inverse_direction = ray.direction.cwiseInverse();
-    const ShapeSet& bounded = group_.bounded();
+    const ShapeSet& bounded = members.bounded();
     if (bounded.size() <= kLinearSpanChildren) {
         count_box_tests(scratch, bounded.size());
         for (std::size_t i = 0; i < bounded.size(); ++i) {
             if (box_hit(bounded.bounds(i), ray, inverse_direction)) {
-                list.push_back(HitRecord{.object = group_.member_of(i)});
+                list.push_back(HitRecord{.object = members.member_of(i)});
             }
         }
     } else {
@@ -99,9 +122,10 @@ void Compound::union_of_spans(const Ray& ray, SpanList& spans, QueryScratch& scr
         // inside it, which is why the interval is not used as it is.)
         Ray line = ray;
         line.t_min = -kInfinity;
-        group_.all_bounded(line, list, scratch);
+        members.all_bounded(line, list, scratch);
     }
-    for (const std::uint32_t index : group_.unbounded()) list.push_back(HitRecord{.object = index});
+    for (const std::uint32_t index : members.unbounded())
+        list.push_back(HitRecord{.object = index});
     std::sort(list.begin(), list.end(),
               [](const HitRecord& a, const HitRecord& b) { return a.object < b.object; });
 

@@ -1,10 +1,13 @@
 #include "csgrt/csg/scene.h"
 
 #include <string>
+#include <unordered_set>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 
+#include "csgrt/accel/built_at_commit.h"
 #include "csgrt/core/error.h"
 #include "csgrt/csg/shape_group.h"
 
@@ -82,11 +85,37 @@ void Scene::set_background(const Vector3& background) {
     background_ = background;
 }
 
+namespace {
+
+/// Hands `config` to every shape below the objects that left its structure to the scene
+/// (BuiltAtCommit: compounds made with build_at_commit), each shared shape once.
+void build_below(const std::vector<SceneObject>& objects, const SceneConfig& config) {
+    std::vector<const Shape*> pending;
+    pending.reserve(objects.size());
+    for (const SceneObject& object : objects) pending.push_back(object.shape.get());
+    std::unordered_set<const Shape*> seen;
+    while (!pending.empty()) {
+        const Shape* shape = pending.back();
+        pending.pop_back();
+        std::vector<const Shape*> children = shape->children();
+        // A leaf is reached once per placement and does nothing; only what has children
+        // (instances, booleans, compounds) is remembered.
+        if (!children.empty() && !seen.insert(shape).second) continue;
+        if (const auto* deferred = dynamic_cast<const BuiltAtCommit*>(shape)) {
+            deferred->build_at_commit(config.accelerator, config.accelerator_config);
+        }
+        pending.insert(pending.end(), children.begin(), children.end());
+    }
+}
+
+}  // namespace
+
 void Scene::commit(const SceneConfig& config) {
     committed_ = false;
     hittable_ = false;
     group_.reset();
     camera_.validate();
+    build_below(objects_, config);
     std::vector<std::shared_ptr<const Shape>> shapes;
     shapes.reserve(objects_.size());
     for (const SceneObject& object : objects_) shapes.push_back(object.shape);

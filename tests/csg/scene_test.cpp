@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -277,6 +278,80 @@ TEST(Scene, CountedQueriesCountAndAgree) {
     // makes some with t_min > t_max, which are rejected before any test).
     EXPECT_GT(valid, 900u);
     EXPECT_EQ(counters.primitives_tested, valid * 301u);
+}
+
+using Shapes = std::vector<std::shared_ptr<const Shape>>;
+
+// 20 spheres on a line, for the compounds below.
+Shapes row_of_spheres() {
+    Shapes spheres;
+    for (int i = 0; i < 20; ++i)
+        spheres.push_back(std::make_shared<Sphere>(Point3(3.0 * i, 0, 0), 1.0));
+    return spheres;
+}
+
+// commit(config) builds the structures left to it below the objects: a build_at_commit compound
+// that says "auto" gets the scene's structure name, one that names its own keeps it, and both get
+// the scene's AcceleratorConfig, here one cell (max_resolution 1; a default grid over 20 members
+// has many), however deep they sit (under an instance and a union, and shared by two objects).
+// A compound built by its constructor keeps its structure; one queried before any commit is built
+// then, with its own configuration, and a later commit leaves it alone.
+TEST(Scene, CommitBuildsTheCompoundsLeftToItWithItsConfiguration) {
+    CompoundConfig deferred;
+    deferred.build_at_commit = true;
+    CompoundConfig deferred_hgrid = deferred;
+    deferred_hgrid.accelerator = "hgrid";
+    auto left_auto = std::make_shared<const Compound>(row_of_spheres(), deferred);
+    auto left_hgrid = std::make_shared<const Compound>(row_of_spheres(), deferred_hgrid);
+    auto built = std::make_shared<const Compound>(row_of_spheres());
+    auto queried = std::make_shared<const Compound>(row_of_spheres(), deferred);
+    EXPECT_FALSE(left_auto->is_built());
+    EXPECT_FALSE(queried->is_built());
+    ASSERT_TRUE(queried->intersect(Ray{Point3(-5, 0, 0), Vector3(1, 0, 0)}));
+    EXPECT_TRUE(queried->is_built());
+    EXPECT_EQ(queried->accelerator_name(), "bvh");  // its own "auto": choose_accelerator
+
+    Scene scene;
+    const auto moved = Transform::translate(Vector3(0, 5, 0));
+    scene.add_object(make_union({std::make_shared<Instance>(left_auto, moved), built}));
+    scene.add_object(
+        std::make_shared<Instance>(left_auto, Transform::translate(Vector3(0, 10, 0))));
+    scene.add_object(left_hgrid);
+    scene.add_object(std::make_shared<Instance>(queried, Transform::translate(Vector3(0, -5, 0))));
+    SceneConfig config;
+    config.accelerator = "grid";
+    config.accelerator_config.grid.max_resolution = 1;
+    config.accelerator_config.hierarchical_grid.max_resolution = 1;
+    config.accelerator_config.hierarchical_grid.max_depth = 0;
+    scene.commit(config);
+
+    ASSERT_TRUE(left_auto->is_built());
+    EXPECT_EQ(left_auto->accelerator_name(), "grid");
+    EXPECT_EQ(left_auto->accelerator_stats().nodes, 1u);
+    EXPECT_EQ(left_hgrid->accelerator_name(), "hgrid");
+    EXPECT_EQ(left_hgrid->accelerator_stats().nodes, 1u);
+    EXPECT_EQ(built->accelerator_name(), "bvh");
+    EXPECT_EQ(queried->accelerator_name(), "bvh");
+    // The same scene committed by default builds the grid it would over 20 members.
+    auto left_default = std::make_shared<const Compound>(row_of_spheres(), deferred);
+    Scene plain;
+    plain.add_object(left_default);
+    plain.commit(structure("grid"));
+    EXPECT_EQ(left_default->accelerator_name(), "grid");
+    EXPECT_GT(left_default->accelerator_stats().nodes, 1u);
+
+    // Whatever built them, every compound answers as a loop over its spheres would.
+    QueryScratch scratch;
+    for (const double y : {-5.0, 0.0, 5.0, 10.0}) {
+        for (int i = 0; i < 20; ++i) {
+            const Ray ray{Point3(3.0 * i + 0.25, y + 4.0, 0.5), Vector3(0, -1, 0)};
+            const std::optional<Hit> hit = scene.intersect(ray, scratch);
+            ASSERT_TRUE(hit) << y << " " << i;
+            // Down onto the sphere of radius 1 around (3 i, y, 0), at x offset 0.25, z 0.5: a
+            // root good to a few ulps (1e-12 is 2^12 ulps of t = 3.2).
+            EXPECT_NEAR(hit->t, 4.0 - std::sqrt(1.0 - 0.25 * 0.25 - 0.5 * 0.5), 1e-12) << y;
+        }
+    }
 }
 
 TEST(Scene, ConcurrentQueriesGiveTheSameAnswers) {

@@ -1,14 +1,17 @@
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/accelerator_config.h"
+#include "csgrt/accel/built_at_commit.h"
 #include "csgrt/accel/factory.h"
 #include "csgrt/core/shape.h"
 #include "csgrt/csg/shape_group.h"
@@ -21,6 +24,11 @@ struct CompoundConfig {
     /// "auto" (choose_accelerator, accel/factory.h) or a name make_accelerator knows.
     std::string accelerator = "auto";
     AcceleratorConfig accelerator_config;
+    /// Leave the structure to the scene (BuiltAtCommit): the first Scene::commit that reaches
+    /// the compound builds it with that scene's configuration (its structure name where
+    /// `accelerator` is "auto", its AcceleratorConfig) instead of the constructor with this
+    /// one. A compound queried before any commit builds it then, with this configuration.
+    bool build_at_commit = false;
 };
 
 /// A plain group of shapes (Suffern, "Ray Tracing from the Ground Up", 2007, ch. 19): the
@@ -39,7 +47,7 @@ struct CompoundConfig {
 /// touch (a ray starting inside one child would otherwise stop at another child's surface
 /// inside the material). For overlapping solids use make_union (csg/boolean.h), which removes
 /// internal surfaces.
-class Compound final : public Shape {
+class Compound final : public Shape, public BuiltAtCommit {
 public:
     /// Throws InvalidParameter for a null child or an unknown structure name.
     explicit Compound(std::vector<std::shared_ptr<const Shape>> children,
@@ -73,17 +81,35 @@ public:
     /// The structure over the bounded children ("" when there are none), why it was chosen,
     /// and its figures.
     std::string_view accelerator_name() const;
-    const std::string& accelerator_reason() const { return group_.accelerator_reason(); }
+    const std::string& accelerator_reason() const { return group().accelerator_reason(); }
     AcceleratorStats accelerator_stats() const;
+    /// Whether the structure is built (false only for a build_at_commit compound before its
+    /// first commit or query).
+    bool is_built() const { return group_.load(std::memory_order_acquire) != nullptr; }
+
+    void build_at_commit(std::string_view accelerator,
+                         const AcceleratorConfig& config) const override;
 
 private:
     /// The children's spans, unioned into `spans`: the candidates are children whose line has a
     /// crossing at some t <= t_max (found through the structure) and unbounded solids.
     void union_of_spans(const Ray& ray, SpanList& spans, QueryScratch& scratch) const;
 
+    /// The children as a group (member index = child index), built on first use when the
+    /// constructor left it to the scene.
+    const ShapeGroup& group() const {
+        const ShapeGroup* built = group_.load(std::memory_order_acquire);
+        return built != nullptr ? *built
+                                : build_group(config_.accelerator, config_.accelerator_config);
+    }
+    const ShapeGroup& build_group(std::string_view accelerator,
+                                  const AcceleratorConfig& config) const;
+
     std::vector<std::shared_ptr<const Shape>> children_;
-    /// The children as a group (member index = child index).
-    ShapeGroup group_;
+    CompoundConfig config_;
+    mutable std::mutex build_mutex_;
+    mutable std::unique_ptr<const ShapeGroup> owned_group_;
+    mutable std::atomic<const ShapeGroup*> group_{nullptr};
     Aabb bounds_;
     bool solid_ = false;
     /// The children's span coincidence tolerance (span_coincidence_relative), chosen once:

@@ -91,7 +91,8 @@ struct SceneObject {
     std::string name;
 };
 
-/// How `commit` organises the top-level objects.
+/// How `commit` organises the top-level objects, and the compounds below them that leave their
+/// structure to the scene (CompoundConfig::build_at_commit).
 struct SceneConfig {
     /// "auto" (the documented rule in docs/scene.md), or a structure name known to
     /// make_accelerator ("brute", "bvh", "grid", "hgrid", "rayclass").
@@ -128,9 +129,11 @@ public:
     /// InvalidParameter unless finite and >= 0 per channel.
     void set_background(const Vector3& background);
 
-    /// Builds everything queries need: validates the camera, computes the bounds, and builds
-    /// the objects' ShapeGroup (csg/shape_group.h), a structure over the bounded objects
-    /// ("auto": choose_accelerator in accel/factory.h, documented in docs/scene.md). Throws
+    /// Builds everything queries need: validates the camera, builds the structures below the
+    /// objects that were left to it (compounds made with build_at_commit: `config`'s structure
+    /// name where theirs is "auto", its AcceleratorConfig), computes the bounds, and builds the
+    /// objects' ShapeGroup (csg/shape_group.h), a structure over the bounded objects ("auto":
+    /// choose_accelerator in accel/factory.h, documented in docs/scene.md). Throws
     /// InvalidParameter for an invalid camera or an unknown structure name; the scene is then left
     /// uncommitted.
     void commit(const SceneConfig& config = {});
