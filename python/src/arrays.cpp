@@ -94,6 +94,16 @@ std::unordered_set<std::string> requested_outputs(const py::object& requested,
     return wanted;
 }
 
+RayQuery ray_query(const py::handle& rays_object, double tnear, double tfar, int nthreads) {
+    RayQuery query;
+    query.rays = float_input(rays_object, "rays", 6, "(..., 6)");
+    check_interval(tnear, tfar);
+    query.tnear = tnear;
+    query.tfar = tfar;
+    query.config = batch_config(nthreads);
+    return query;
+}
+
 void check_samples(int nsamples) {
     if (nsamples != 1) {
         throw py::value_error("nsamples: csgrt decides inside/outside with one ray (the "

@@ -84,4 +84,14 @@ inline constexpr const char* kPointsDoc =
 inline constexpr const char* kThreadsDoc =
     "nthreads: worker threads, 0 (default) for every core. Results do not depend on it.";
 
+/// The end of every ray query's docstring: the rays, the interval, the threads.
+inline std::string ray_query_doc() {
+    return std::string(kRaysDoc) + "\ntnear, tfar: the interval of t searched (closed).\n" +
+           kThreadsDoc;
+}
+/// The end of every point query's docstring: the points, the threads.
+inline std::string point_query_doc() {
+    return std::string(kPointsDoc) + "\n" + kThreadsDoc;
+}
+
 }  // namespace csgrt::python

@@ -28,6 +28,27 @@ inline constexpr const char* kMaterialOutput = "material_ids";
 std::unordered_set<std::string> requested_outputs(const py::object& requested,
                                                   bool with_materials);
 
+/// The checked arguments of a ray query: the rays (float_input), the interval and the
+/// threads, checked in that order.
+struct RayQuery {
+    FloatInput rays;
+    double tnear = 0.0;
+    double tfar = kInfinity;
+    BatchConfig config;
+
+    /// Calls run(ray arrays) on the rays in their own precision, without the GIL.
+    template <class Run>
+    void run_without_gil(Run&& run) const {
+        py::gil_scoped_release release;
+        if (rays.is_float32) {
+            run(ray_arrays<float>(rays, tnear, tfar));
+        } else {
+            run(ray_arrays<double>(rays, tnear, tfar));
+        }
+    }
+};
+RayQuery ray_query(const py::handle& rays_object, double tnear, double tfar, int nthreads);
+
 template <class Real, class Target>
 py::dict cast_rays_as(const Target& target, const FloatInput& rays, double tnear, double tfar,
                       const std::unordered_set<std::string>& wanted, const BatchConfig& config) {
@@ -76,19 +97,12 @@ py::dict cast_rays(const Target& target, const py::handle& rays_object, double t
 template <class Target>
 py::array_t<bool> test_occlusions(const Target& target, const py::handle& rays_object,
                                   double tnear, double tfar, int nthreads) {
-    const FloatInput rays = float_input(rays_object, "rays", 6, "(..., 6)");
-    check_interval(tnear, tfar);
-    const BatchConfig config = batch_config(nthreads);
-    auto result = output<bool>(rays.leading);
+    const RayQuery query = ray_query(rays_object, tnear, tfar, nthreads);
+    auto result = output<bool>(query.rays.leading);
     // NumPy's bool is one byte holding 0 or 1: the batch's uint8 answers, in place.
     const std::span<std::uint8_t> out(reinterpret_cast<std::uint8_t*>(result.mutable_data()),
-                                      rays.count);
-    py::gil_scoped_release release;
-    if (rays.is_float32) {
-        occluded(target, ray_arrays<float>(rays, tnear, tfar), out, config);
-    } else {
-        occluded(target, ray_arrays<double>(rays, tnear, tfar), out, config);
-    }
+                                      query.rays.count);
+    query.run_without_gil([&](const auto& view) { occluded(target, view, out, query.config); });
     return result;
 }
 
@@ -96,19 +110,13 @@ template <class Target>
 py::array_t<std::int32_t> count_intersections(const Target& target,
                                               const py::handle& rays_object, double tnear,
                                               double tfar, int nthreads) {
-    const FloatInput rays = float_input(rays_object, "rays", 6, "(..., 6)");
-    check_interval(tnear, tfar);
-    const BatchConfig config = batch_config(nthreads);
-    auto result = output<std::int32_t>(rays.leading);  // Open3D's dtype
+    const RayQuery query = ray_query(rays_object, tnear, tfar, nthreads);
+    auto result = output<std::int32_t>(query.rays.leading);  // Open3D's dtype
     // Counts are far below 2^31; signed and unsigned variants of one type may alias.
     const std::span<std::uint32_t> out(reinterpret_cast<std::uint32_t*>(result.mutable_data()),
-                                       rays.count);
-    py::gil_scoped_release release;
-    if (rays.is_float32) {
-        count_crossings(target, ray_arrays<float>(rays, tnear, tfar), out, config);
-    } else {
-        count_crossings(target, ray_arrays<double>(rays, tnear, tfar), out, config);
-    }
+                                       query.rays.count);
+    query.run_without_gil(
+        [&](const auto& view) { count_crossings(target, view, out, query.config); });
     return result;
 }
 
@@ -160,11 +168,10 @@ py::dict list_intersections_as(const Target& target, const FloatInput& rays, dou
 template <class Target>
 py::dict list_intersections(const Target& target, const py::handle& rays_object, double tnear,
                             double tfar, int nthreads) {
-    const FloatInput rays = float_input(rays_object, "rays", 6, "(..., 6)");
-    check_interval(tnear, tfar);
-    const BatchConfig config = batch_config(nthreads);
-    return rays.is_float32 ? list_intersections_as<float>(target, rays, tnear, tfar, config)
-                           : list_intersections_as<double>(target, rays, tnear, tfar, config);
+    const RayQuery query = ray_query(rays_object, tnear, tfar, nthreads);
+    return query.rays.is_float32
+               ? list_intersections_as<float>(target, query.rays, tnear, tfar, query.config)
+               : list_intersections_as<double>(target, query.rays, tnear, tfar, query.config);
 }
 
 void check_samples(int nsamples);
@@ -186,6 +193,74 @@ py::array_t<float> compute_occupancy(const Target& target, const py::handle& poi
     }
     for (std::size_t i = 0; i < points.count; ++i) out[i] = inside[i] ? 1.0f : 0.0f;
     return result;
+}
+
+/// The docstrings of the queries both scene classes bind (bind_queries): each says what its
+/// targets are.
+struct QueryDocs {
+    std::string cast_rays;
+    std::string test_occlusions;
+    std::string count_intersections;
+    std::string list_intersections;
+    std::string compute_occupancy;
+};
+
+/// Binds cast_rays, test_occlusions, count_intersections, list_intersections and
+/// compute_occupancy on `cls` with the same arguments and defaults in both scene classes, each
+/// answered on the target `with_target(self, query)` hands to `query` (a RaycastingScene's
+/// snapshot, a Scene's committed scene), which it keeps alive for the query.
+template <class Class, class WithTarget>
+void bind_queries(Class& cls, WithTarget with_target, const QueryDocs& docs) {
+    using namespace pybind11::literals;
+    using Self = typename Class::type;
+    cls.def(
+        "cast_rays",
+        [with_target](const Self& self, const py::handle& rays, double tnear, double tfar,
+                      const py::object& outputs, int nthreads) {
+            return with_target(self, [&](const auto& target) {
+                return cast_rays(target, rays, tnear, tfar, outputs, nthreads);
+            });
+        },
+        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "outputs"_a = py::none(), "nthreads"_a = 0,
+        docs.cast_rays.c_str());
+    cls.def(
+        "test_occlusions",
+        [with_target](const Self& self, const py::handle& rays, double tnear, double tfar,
+                      int nthreads) {
+            return with_target(self, [&](const auto& target) {
+                return test_occlusions(target, rays, tnear, tfar, nthreads);
+            });
+        },
+        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
+        docs.test_occlusions.c_str());
+    cls.def(
+        "count_intersections",
+        [with_target](const Self& self, const py::handle& rays, double tnear, double tfar,
+                      int nthreads) {
+            return with_target(self, [&](const auto& target) {
+                return count_intersections(target, rays, tnear, tfar, nthreads);
+            });
+        },
+        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
+        docs.count_intersections.c_str());
+    cls.def(
+        "list_intersections",
+        [with_target](const Self& self, const py::handle& rays, double tnear, double tfar,
+                      int nthreads) {
+            return with_target(self, [&](const auto& target) {
+                return list_intersections(target, rays, tnear, tfar, nthreads);
+            });
+        },
+        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
+        docs.list_intersections.c_str());
+    cls.def(
+        "compute_occupancy",
+        [with_target](const Self& self, const py::handle& points, int nthreads, int nsamples) {
+            return with_target(self, [&](const auto& target) {
+                return compute_occupancy(target, points, nthreads, nsamples);
+            });
+        },
+        "query_points"_a, "nthreads"_a = 0, "nsamples"_a = 1, docs.compute_occupancy.c_str());
 }
 
 }  // namespace csgrt::python

@@ -240,19 +240,10 @@ in Open3D); primitive ids in results are the row of ``triangles``.
     scene.def_property_readonly("triangle_count", &RaycastingScene::triangle_count,
                                 "Triangles over all meshes.");
 
-    const std::string rays_doc = std::string(kRaysDoc) +
-                                 "\ntnear, tfar: the interval of t searched (closed).\n" +
-                                 kThreadsDoc;
-    scene.def(
-        "cast_rays",
-        [](const RaycastingScene& self, const py::handle& rays, double tnear, double tfar,
-           const py::object& outputs, int nthreads) {
-            const auto snapshot = self.snapshot();
-            return cast_rays(snapshot->view(), rays, tnear, tfar, outputs, nthreads);
-        },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "outputs"_a = py::none(),
-        "nthreads"_a = 0,
-        (R"doc(
+    const std::string rays_doc = ray_query_doc();
+    const std::string points_doc = point_query_doc();
+    QueryDocs docs;
+    docs.cast_rays = R"doc(
 The nearest hit of every ray. Returns a dict of arrays with the rays' leading shape:
 
 - ``t_hit`` (...): the ray parameter of the hit, inf for a miss;
@@ -265,57 +256,36 @@ The nearest hit of every ray. Returns a dict of arrays with the rays' leading sh
 Floating-point results have the rays' precision (float32 in, float32 out).
 outputs: None for the five Open3D outputs, or a list of the names wanted; a query that asks
 only for "t_hit" does only the traversal.
-)doc" + rays_doc).c_str());
-    scene.def(
-        "test_occlusions",
-        [](const RaycastingScene& self, const py::handle& rays, double tnear, double tfar,
-           int nthreads) {
-            const auto snapshot = self.snapshot();
-            return test_occlusions(snapshot->view(), rays, tnear, tfar, nthreads);
-        },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
-        ("Whether anything is hit in [tnear, tfar] along each ray (shadow rays): a bool array "
-         "of the rays' leading shape. Stops at the first hit found.\n" +
-         rays_doc).c_str());
-    scene.def(
-        "count_intersections",
-        [](const RaycastingScene& self, const py::handle& rays, double tnear, double tfar,
-           int nthreads) {
-            const auto snapshot = self.snapshot();
-            return count_intersections(snapshot->view(), rays, tnear, tfar, nthreads);
-        },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
-        ("How many times each ray crosses a surface in [tnear, tfar]: an int32 array of the "
-         "rays' leading shape. Hits at one t on one mesh (a ray through a shared edge or "
-         "vertex) count once.\n" + rays_doc).c_str());
-    scene.def(
-        "list_intersections",
-        [](const RaycastingScene& self, const py::handle& rays, double tnear, double tfar,
-           int nthreads) {
-            const auto snapshot = self.snapshot();
-            return list_intersections(snapshot->view(), rays, tnear, tfar, nthreads);
-        },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
-        (R"doc(
+)doc" + rays_doc;
+    docs.test_occlusions =
+        "Whether anything is hit in [tnear, tfar] along each ray (shadow rays): a bool array "
+        "of the rays' leading shape. Stops at the first hit found.\n" +
+        rays_doc;
+    docs.count_intersections =
+        "How many times each ray crosses a surface in [tnear, tfar]: an int32 array of the "
+        "rays' leading shape. Hits at one t on one mesh (a ray through a shared edge or "
+        "vertex) count once.\n" +
+        rays_doc;
+    docs.list_intersections = R"doc(
 Every crossing of every ray, sorted by t along each ray, counted as count_intersections counts
 them. Returns a dict of flat arrays: ``ray_splits`` (number of rays + 1; ray i's crossings are
 rows ray_splits[i]:ray_splits[i+1]), ``ray_ids``, ``geometry_ids``, ``primitive_ids``,
 ``primitive_uvs`` (K, 2), ``t_hit``, and ``entering`` (bool: the ray goes against the
 triangle's normal, into the solid of an outward-wound closed mesh).
-)doc" + rays_doc).c_str());
-    const std::string points_doc = std::string(kPointsDoc) + "\n" + kThreadsDoc;
-    scene.def(
-        "compute_occupancy",
-        [](const RaycastingScene& self, const py::handle& points, int nthreads, int nsamples) {
+)doc" + rays_doc;
+    docs.compute_occupancy =
+        "1.0 where a point is inside the meshes, 0.0 outside (float32, the points' leading "
+        "shape). Inside means an odd number of crossings along one fixed ray from the point, "
+        "as in Open3D: meant for closed meshes, whatever their winding.\n"
+        "nsamples: must be 1 (Open3D's vote over several rays is not offered).\n" +
+        points_doc;
+    bind_queries(
+        scene,
+        [](const RaycastingScene& self, const auto& query) {
             const auto snapshot = self.snapshot();
-            return compute_occupancy(snapshot->view(), points, nthreads, nsamples);
+            return query(snapshot->view());
         },
-        "query_points"_a, "nthreads"_a = 0, "nsamples"_a = 1,
-        ("1.0 where a point is inside the meshes, 0.0 outside (float32, the points' leading "
-         "shape). Inside means an odd number of crossings along one fixed ray from the point, "
-         "as in Open3D: meant for closed meshes, whatever their winding.\n"
-         "nsamples: must be 1 (Open3D's vote over several rays is not offered).\n" +
-         points_doc).c_str());
+        docs);
     scene.def(
         "compute_closest_points",
         [](const RaycastingScene& self, const py::handle& points_object, int nthreads) {

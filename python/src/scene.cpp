@@ -330,62 +330,36 @@ shape. Objects added after commit() are seen by queries after the next commit().
         [](const PyScene& self) { return std::string(self.committed()->accelerator_name()); },
         "The structure commit() chose over the objects.");
 
-    const std::string rays_doc = std::string(kRaysDoc) +
-                                 "\ntnear, tfar: the interval of t searched (closed).\n" +
-                                 kThreadsDoc;
-    scene.def(
-        "cast_rays",
-        [](const PyScene& self, const py::handle& rays, double tnear, double tfar,
-           const py::object& outputs, int nthreads) {
+    const std::string rays_doc = ray_query_doc();
+    QueryDocs docs;
+    docs.cast_rays =
+        "The nearest hit of every ray, as RaycastingScene.cast_rays: t_hit, geometry_ids "
+        "(object ids), primitive_ids (the leaf's own sub-primitive: triangle, box face, cap), "
+        "primitive_uvs (the surface's uv), primitive_normals (geometric, outward for solids) "
+        "and, when asked for in outputs, shading_normals (interpolated on meshes).\n" +
+        rays_doc;
+    docs.test_occlusions =
+        "Whether anything is hit in [tnear, tfar] along each ray (bool array).\n" + rays_doc;
+    docs.count_intersections =
+        "How many surfaces each ray crosses in [tnear, tfar] (int32): its successive nearest "
+        "hits, each searched just beyond the last, so coincident surfaces count once.\n" +
+        rays_doc;
+    docs.list_intersections =
+        "Every crossing, as RaycastingScene.list_intersections; `entering` is True where the "
+        "ray arrives on the side the surface's normal points to (into a solid).\n" +
+        rays_doc;
+    docs.compute_occupancy =
+        "1.0 where a point is inside a solid object (CSG trees, analytic solids, closed "
+        "meshes; each solid's own exact membership test), 0.0 elsewhere (float32).\n"
+        "nsamples: must be 1.\n" +
+        point_query_doc();
+    bind_queries(
+        scene,
+        [](const PyScene& self, const auto& query) {
             const auto committed = self.committed();
-            return cast_rays(*committed, rays, tnear, tfar, outputs, nthreads);
+            return query(*committed);
         },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "outputs"_a = py::none(),
-        "nthreads"_a = 0,
-        ("The nearest hit of every ray, as RaycastingScene.cast_rays: t_hit, geometry_ids "
-         "(object ids), primitive_ids (the leaf's own sub-primitive: triangle, box face, cap), "
-         "primitive_uvs (the surface's uv), primitive_normals (geometric, outward for solids) "
-         "and, when asked for in outputs, shading_normals (interpolated on meshes).\n" +
-         rays_doc).c_str());
-    scene.def(
-        "test_occlusions",
-        [](const PyScene& self, const py::handle& rays, double tnear, double tfar, int nthreads) {
-            const auto committed = self.committed();
-            return test_occlusions(*committed, rays, tnear, tfar, nthreads);
-        },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
-        ("Whether anything is hit in [tnear, tfar] along each ray (bool array).\n" + rays_doc)
-            .c_str());
-    scene.def(
-        "count_intersections",
-        [](const PyScene& self, const py::handle& rays, double tnear, double tfar, int nthreads) {
-            const auto committed = self.committed();
-            return count_intersections(*committed, rays, tnear, tfar, nthreads);
-        },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
-        ("How many surfaces each ray crosses in [tnear, tfar] (int32): its successive nearest "
-         "hits, each searched just beyond the last, so coincident surfaces count once.\n" +
-         rays_doc).c_str());
-    scene.def(
-        "list_intersections",
-        [](const PyScene& self, const py::handle& rays, double tnear, double tfar, int nthreads) {
-            const auto committed = self.committed();
-            return list_intersections(*committed, rays, tnear, tfar, nthreads);
-        },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
-        ("Every crossing, as RaycastingScene.list_intersections; `entering` is True where the "
-         "ray arrives on the side the surface's normal points to (into a solid).\n" + rays_doc)
-            .c_str());
-    scene.def(
-        "compute_occupancy",
-        [](const PyScene& self, const py::handle& points, int nthreads, int nsamples) {
-            const auto committed = self.committed();
-            return compute_occupancy(*committed, points, nthreads, nsamples);
-        },
-        "query_points"_a, "nthreads"_a = 0, "nsamples"_a = 1,
-        ("1.0 where a point is inside a solid object (CSG trees, analytic solids, closed "
-         "meshes; each solid's own exact membership test), 0.0 elsewhere (float32).\n"
-         "nsamples: must be 1.\n" + std::string(kPointsDoc) + "\n" + kThreadsDoc).c_str());
+        docs);
     bind_rendering(scene);
 
     m.def(
