@@ -89,11 +89,8 @@ TEST(Annulus, TiltedNormalUsesItsFrame) {
 }
 
 TEST(Annulus, ParallelRaysNeverHitEvenInThePlane) {
-    for (const Ray& ray : {Ray{Point3(-5, 1, 1.5), Vector3(1, 0, 0)},
-                           Ray{Point3(-5, 1.2, 1.5), Vector3(1, 0, 0.1)}}) {
-        EXPECT_FALSE(kRing.intersect(ray));
-        EXPECT_FALSE(kRing.occluded(ray));
-    }
+    test::expect_misses(kRing, {Ray{Point3(-5, 1, 1.5), Vector3(1, 0, 0)},
+                                Ray{Point3(-5, 1.2, 1.5), Vector3(1, 0, 0.1)}});
 }
 
 TEST(Annulus, RayStartingOnIt) {

@@ -12,6 +12,7 @@
 #include "csgrt/core/cylinder.h"
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
+#include "support/error_of.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -287,14 +288,7 @@ TEST(Cone, InvalidRaysNeverHit) {
 }
 
 void expect_rejected(double base, double top, double height, const std::string& parameter) {
-    try {
-        Cone(base, top, height, true);
-        ADD_FAILURE() << "accepted " << parameter;
-    } catch (const InvalidParameter& error) {
-        const std::string message = error.what();
-        EXPECT_NE(message.find("Cone"), std::string::npos) << message;
-        EXPECT_NE(message.find(parameter), std::string::npos) << message;
-    }
+    test::expect_rejected_naming([&] { Cone(base, top, height, true); }, "Cone", parameter);
 }
 
 TEST(Cone, RejectsBadParametersNamingThem) {

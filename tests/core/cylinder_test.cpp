@@ -11,6 +11,7 @@
 
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
+#include "support/error_of.h"
 #include "support/leaf_checks.h"
 #include "support/shape_properties.h"
 
@@ -205,24 +206,14 @@ TEST(Cylinder, IntervalHonouredAtBothEnds) {
 }
 
 TEST(Cylinder, InvalidRaysNeverHit) {
-    for (const Ray& ray : test::invalid_variants(Ray{Point3(0, 0, -5), Vector3(0, 0, 1)})) {
-        for (const Cylinder* cylinder : {&kOpen, &kCapped}) {
-            EXPECT_FALSE(cylinder->intersect(ray));
-            EXPECT_FALSE(cylinder->occluded(ray));
-            EXPECT_TRUE(cylinder->spans(ray).empty());
-        }
+    for (const Cylinder* cylinder : {&kOpen, &kCapped}) {
+        test::expect_invalid_rays_miss(*cylinder, Ray{Point3(0, 0, -5), Vector3(0, 0, 1)});
     }
 }
 
 void expect_rejected(double radius, double y_min, double y_max, const std::string& parameter) {
-    try {
-        Cylinder(radius, y_min, y_max, true);
-        ADD_FAILURE() << "accepted " << parameter;
-    } catch (const InvalidParameter& error) {
-        const std::string message = error.what();
-        EXPECT_NE(message.find("Cylinder"), std::string::npos) << message;
-        EXPECT_NE(message.find(parameter), std::string::npos) << message;
-    }
+    test::expect_rejected_naming([&] { Cylinder(radius, y_min, y_max, true); }, "Cylinder",
+                                 parameter);
 }
 
 TEST(Cylinder, RejectsBadParametersNamingThem) {

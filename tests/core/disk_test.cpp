@@ -55,20 +55,12 @@ TEST(Disk, MissesOutsideAndPointingAway) {
 }
 
 TEST(Disk, ParallelRaysNeverHitEvenInThePlane) {
-    for (const Ray& ray : {Ray{Point3(-5, 1, 0), Vector3(1, 0, 0)},  // in the plane, across
-                           Ray{Point3(-5, 1.5, 0), Vector3(1, 0, 0.2)}}) {
-        EXPECT_FALSE(kDisk.intersect(ray));
-        EXPECT_FALSE(kDisk.occluded(ray));
-    }
+    test::expect_misses(kDisk, {Ray{Point3(-5, 1, 0), Vector3(1, 0, 0)},  // in the plane, across
+                                Ray{Point3(-5, 1.5, 0), Vector3(1, 0, 0.2)}});
 }
 
 TEST(Disk, RayStartingOnTheDisk) {
-    Ray ray{Point3(0.5, 1, 0.5), Vector3(1, 1, 0)};
-    const std::optional<Hit> hit = kDisk.intersect(ray);
-    ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 0.0);
-    ray.t_min = 1e-12;
-    EXPECT_FALSE(kDisk.intersect(ray));
+    test::expect_hit_only_at_start(kDisk, Ray{Point3(0.5, 1, 0.5), Vector3(1, 1, 0)});
 }
 
 TEST(Disk, IntervalHonouredAtBothEnds) {
@@ -77,10 +69,7 @@ TEST(Disk, IntervalHonouredAtBothEnds) {
 }
 
 TEST(Disk, InvalidRaysNeverHit) {
-    for (const Ray& ray : test::invalid_variants(Ray{Point3(0, 5, 0), Vector3(0, -1, 0)})) {
-        EXPECT_FALSE(kDisk.intersect(ray));
-        EXPECT_FALSE(kDisk.occluded(ray));
-    }
+    test::expect_invalid_rays_miss(kDisk, Ray{Point3(0, 5, 0), Vector3(0, -1, 0)});
 }
 
 TEST(Disk, RejectsBadParametersNamingThem) {

@@ -10,6 +10,7 @@
 
 #include "csgrt/core/cylinder.h"
 #include "csgrt/core/error.h"
+#include "support/error_of.h"
 #include "support/leaf_checks.h"
 #include "support/shape_properties.h"
 
@@ -145,22 +146,13 @@ TEST(PartCylinder, IntervalHonouredAtBothEnds) {
 }
 
 TEST(PartCylinder, InvalidRaysNeverHit) {
-    for (const Ray& ray : test::invalid_variants(Ray{Point3(0.5, 0, 5), Vector3(0, 0, -1)})) {
-        EXPECT_FALSE(kQuarter.intersect(ray));
-        EXPECT_FALSE(kQuarter.occluded(ray));
-    }
+    test::expect_invalid_rays_miss(kQuarter, Ray{Point3(0.5, 0, 5), Vector3(0, 0, -1)});
 }
 
 void expect_rejected(double radius, double y_min, double y_max, double phi_min, double phi_max,
                      const std::string& parameter) {
-    try {
-        PartCylinder(radius, y_min, y_max, phi_min, phi_max);
-        ADD_FAILURE() << "accepted " << parameter;
-    } catch (const InvalidParameter& error) {
-        const std::string message = error.what();
-        EXPECT_NE(message.find("PartCylinder"), std::string::npos) << message;
-        EXPECT_NE(message.find(parameter), std::string::npos) << message;
-    }
+    test::expect_rejected_naming([&] { PartCylinder(radius, y_min, y_max, phi_min, phi_max); },
+                                 "PartCylinder", parameter);
 }
 
 TEST(PartCylinder, RejectsBadParametersNamingThem) {

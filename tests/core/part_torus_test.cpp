@@ -6,6 +6,7 @@
 #include <string>
 
 #include "csgrt/core/error.h"
+#include "support/leaf_checks.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -236,13 +237,10 @@ TEST(PartTorus, IsAnOpenSurface) {
 TEST(PartTorus, InvalidRaysNeverHit) {
     const PartTorus part(kMajor, kMinor, 0.0, kPi, 0.0, kTwoPi);
     const double nan = std::nan("");
-    for (const Ray& ray :
-         {Ray{Point3(nan, 0, 0), Vector3(-1, 0, 0)}, Ray{Point3(5, 0, 0), Vector3(0, 0, 0)},
-          Ray{Point3(5, 0, 0), Vector3(-1, kInfinity, 0)},
-          Ray{Point3(5, 0, 0), Vector3(-1, 0, 0), 3.0, 2.0}}) {
-        EXPECT_FALSE(part.intersect(ray));
-        EXPECT_FALSE(part.occluded(ray));
-    }
+    test::expect_misses(
+        part, {Ray{Point3(nan, 0, 0), Vector3(-1, 0, 0)}, Ray{Point3(5, 0, 0), Vector3(0, 0, 0)},
+               Ray{Point3(5, 0, 0), Vector3(-1, kInfinity, 0)},
+               Ray{Point3(5, 0, 0), Vector3(-1, 0, 0), 3.0, 2.0}});
 }
 
 TEST(PartTorus, RejectsBadParameters) {

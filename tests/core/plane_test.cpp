@@ -46,24 +46,15 @@ TEST(Plane, PointingAwayMisses) {
 }
 
 TEST(Plane, ParallelRaysNeverHitEvenInThePlane) {
-    for (const Ray& ray : {Ray{Point3(0, 2, 0), Vector3(1, 0, 0)},  // above, parallel
-                           Ray{Point3(0, 1, 0), Vector3(1, 0, 0)},  // lying in the plane
-                           Ray{Point3(3, 1, -2), Vector3(0, 0, -5)}}) {
-        EXPECT_FALSE(kGround.intersect(ray));
-        EXPECT_FALSE(kGround.occluded(ray));
-    }
+    test::expect_misses(kGround, {Ray{Point3(0, 2, 0), Vector3(1, 0, 0)},  // above, parallel
+                                  Ray{Point3(0, 1, 0), Vector3(1, 0, 0)},  // lying in the plane
+                                  Ray{Point3(3, 1, -2), Vector3(0, 0, -5)}});
 }
 
 TEST(Plane, RayStartingOnThePlane) {
     // A ray from the surface (t = 0) hits it when the interval includes 0 and not otherwise:
     // that is what a spawned ray needs its t_min for.
-    Ray ray{Point3(0.25, 1, 0.5), Vector3(1, -1, 0)};
-    const std::optional<Hit> hit = kGround.intersect(ray);
-    ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 0.0);
-    ray.t_min = 1e-12;
-    EXPECT_FALSE(kGround.intersect(ray));
-    EXPECT_FALSE(kGround.occluded(ray));
+    test::expect_hit_only_at_start(kGround, Ray{Point3(0.25, 1, 0.5), Vector3(1, -1, 0)});
 }
 
 TEST(Plane, IntervalHonouredAtBothEnds) {
@@ -76,11 +67,7 @@ TEST(Plane, IntervalHonouredAtBothEnds) {
 }
 
 TEST(Plane, InvalidRaysNeverHit) {
-    for (const Ray& ray : test::invalid_variants(Ray{Point3(0, 5, 0), Vector3(0, -1, 0)})) {
-        EXPECT_FALSE(kGround.intersect(ray));
-        EXPECT_FALSE(kGround.occluded(ray));
-        EXPECT_TRUE(kGround.spans(ray).empty());
-    }
+    test::expect_invalid_rays_miss(kGround, Ray{Point3(0, 5, 0), Vector3(0, -1, 0)});
 }
 
 TEST(Plane, RejectsBadParametersNamingThem) {

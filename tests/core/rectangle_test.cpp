@@ -57,21 +57,12 @@ TEST(Rectangle, EdgesAndCornersBelongToIt) {
 }
 
 TEST(Rectangle, ParallelRaysNeverHitEvenInThePlane) {
-    for (const Ray& ray :
-         {Ray{Point3(-1, 0, 1), Vector3(1, 0, 0)}, Ray{Point3(-1, 0.5, 1), Vector3(1, 0, 0.1)}}) {
-        EXPECT_FALSE(kRectangle.intersect(ray));
-        EXPECT_FALSE(kRectangle.occluded(ray));
-    }
+    test::expect_misses(kRectangle, {Ray{Point3(-1, 0, 1), Vector3(1, 0, 0)},
+                                     Ray{Point3(-1, 0.5, 1), Vector3(1, 0, 0.1)}});
 }
 
 TEST(Rectangle, RayStartingOnItAndPointingAway) {
-    Ray ray{Point3(1, 0, 1), Vector3(0.3, 1, 0.2)};
-    const std::optional<Hit> hit = kRectangle.intersect(ray);
-    ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 0.0);
-    ray.t_min = 1e-12;
-    EXPECT_FALSE(kRectangle.intersect(ray));
-    EXPECT_FALSE(kRectangle.occluded(ray));
+    test::expect_hit_only_at_start(kRectangle, Ray{Point3(1, 0, 1), Vector3(0.3, 1, 0.2)});
 }
 
 TEST(Rectangle, IntervalHonouredAtBothEnds) {
@@ -80,10 +71,7 @@ TEST(Rectangle, IntervalHonouredAtBothEnds) {
 }
 
 TEST(Rectangle, InvalidRaysNeverHit) {
-    for (const Ray& ray : test::invalid_variants(Ray{Point3(1, 4, 1), Vector3(0, -1, 0)})) {
-        EXPECT_FALSE(kRectangle.intersect(ray));
-        EXPECT_FALSE(kRectangle.occluded(ray));
-    }
+    test::expect_invalid_rays_miss(kRectangle, Ray{Point3(1, 4, 1), Vector3(0, -1, 0)});
 }
 
 TEST(Rectangle, RejectsBadParametersNamingThem) {

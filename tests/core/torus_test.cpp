@@ -11,13 +11,13 @@
 #include "csgrt/core/error.h"
 #include "csgrt/core/instance.h"
 #include "csgrt/core/polynomial.h"
+#include "stress/reference_shapes.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
 namespace {
 
-using Long = long double;
-using LongVector = Eigen::Matrix<long double, 3, 1>;
+using test::Long;
 
 const Torus kTorus(2.0, 0.5);
 
@@ -315,85 +315,33 @@ TEST(Torus, PropertiesOnRandomRays) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Accuracy against a long double reference, written here independently of torus.cpp: the
-// quartic of the same (double) ray, built in long double around the point of the line nearest
-// the centre, solved by the long double solve_quartic on the chord of the sphere of radius
-// R + 2 r, each root then polished by Newton on the tube function in long double along the
-// original ray. Its error (u = 2^-64) is negligible next to double's.
+// Accuracy against a long double reference, written independently of torus.cpp: the torus of
+// the stress tests' long double models (TorusPatch, tests/stress/reference_shapes.h), whose
+// quartic of the same (double) ray is built in long double around the point of the line
+// nearest the centre, solved by the long double solve_quartic on the chord of the sphere of
+// radius R + 2 r, each root then polished by Newton on the tube function in long double along
+// the original ray. Its error (u = 2^-64) is negligible next to double's.
 // ---------------------------------------------------------------------------------------------
 
-struct ReferenceRoot {
-    Long t;
-    Long cosine;  // |cos| of the angle between the ray and the surface normal
-};
-
 struct Reference {
-    std::vector<ReferenceRoot> roots;
+    /// The roots, with |cos| of the angle between the ray and the surface normal at each.
+    std::vector<test::Crossing> roots;
     // The extremum of the quartic along the line (a near-tangency) where the line comes
     // closest to the surface: its distance to the surface, and its t.
     Long closest_approach = kInfinity;
     Long closest_t = 0;
 };
 
-Long tube_value(Long major, Long minor, const LongVector& p) {
-    const Long rho = std::sqrt(p.x() * p.x() + p.z() * p.z());
-    return (rho - major) * (rho - major) + p.y() * p.y() - minor * minor;
-}
-
-Long surface_distance(Long major, Long minor, const LongVector& p) {
-    const Long rho = std::sqrt(p.x() * p.x() + p.z() * p.z());
-    return std::sqrt((rho - major) * (rho - major) + p.y() * p.y()) - minor;
-}
-
 Reference reference_roots(double major_radius, double minor_radius, const Ray& ray) {
-    const Long major = major_radius;
-    const Long minor = minor_radius;
-    const LongVector o = ray.origin.cast<Long>();
-    const LongVector d = ray.direction.cast<Long>();
+    const test::TorusPatch torus{major_radius, minor_radius, {}};
+    test::LineCrossings line;
+    torus.crossings(test::to_long(ray), line);
     Reference reference;
-    const Long a = d.squaredNorm();
-    const Long t_center = -o.dot(d) / a;
-    const LongVector p = o + t_center * d;
-    const Long reach = major + 2 * minor;
-    if (p.squaredNorm() >= reach * reach) return reference;
-    const Long half_chord = std::sqrt((reach * reach - p.squaredNorm()) / a);
-    const Long b = p.dot(d);
-    const Long c = p.squaredNorm() + major * major - minor * minor;
-    const Long dxz = d.x() * d.x() + d.z() * d.z();
-    const Long exz = p.x() * d.x() + p.z() * d.z();
-    const Long fxz = p.x() * p.x() + p.z() * p.z();
-    const Long coeffs[5] = {c * c - 4 * major * major * fxz, 4 * b * c - 8 * major * major * exz,
-                            4 * b * b + 2 * a * c - 4 * major * major * dxz, 4 * a * b, a * a};
-    Long roots[4];
-    const int count = solve_quartic(coeffs, -half_chord, half_chord, roots);
-    for (int i = 0; i < count; ++i) {
-        Long t = t_center + roots[i];
-        const bool tangent =
-            (i > 0 && roots[i - 1] == roots[i]) || (i + 1 < count && roots[i + 1] == roots[i]);
-        for (int step = 0; step < 4 && !tangent; ++step) {
-            const LongVector q = o + t * d;
-            const Long rho = std::sqrt(q.x() * q.x() + q.z() * q.z());
-            const Long slope =
-                2 * ((rho - major) * (q.x() * d.x() + q.z() * d.z()) / rho + q.y() * d.y());
-            t -= tube_value(major, minor, q) / slope;
-        }
-        const LongVector q = o + t * d;
-        const Long rho = std::sqrt(q.x() * q.x() + q.z() * q.z());
-        LongVector normal(q.x() * (rho - major) / rho, q.y(), q.z() * (rho - major) / rho);
-        normal.normalize();
-        reference.roots.push_back({t, std::abs(normal.dot(d)) / std::sqrt(a)});
-    }
-    // Extrema of the quartic inside the chord: candidates for near-tangencies.
-    Long extrema[3];
-    const int extremum_count =
-        solve_cubic(4 * coeffs[4], 3 * coeffs[3], 2 * coeffs[2], coeffs[1], extrema);
-    for (int i = 0; i < extremum_count; ++i) {
-        if (std::abs(extrema[i]) > half_chord) continue;
-        const Long t = t_center + extrema[i];
-        const Long distance = std::abs(surface_distance(major, minor, o + t * d));
-        if (distance < reference.closest_approach) {
-            reference.closest_approach = distance;
-            reference.closest_t = t;
+    reference.roots = line.crossings;
+    for (const test::NearTangency& near : line.tangencies) {
+        if (near.distance < reference.closest_approach) {
+            reference.closest_approach = near.distance;
+            reference.closest_t = near.t;
         }
     }
     return reference;
@@ -475,7 +423,7 @@ AccuracyStats measure_accuracy(double major, double minor, double distance, int 
         if (found.size() != reference.roots.size()) continue;
         if (!found.empty()) ++stats.hit_rays;
         for (std::size_t k = 0; k < found.size(); ++k) {
-            const ReferenceRoot& expected = reference.roots[k];
+            const test::Crossing& expected = reference.roots[k];
             const double t = static_cast<double>(expected.t);
             const double error = static_cast<double>(std::abs(found[k] - expected.t));
             const double bound = 8 * point_scale(ray, t, major, minor) /

@@ -150,12 +150,7 @@ TEST(Triangle, RaysInOrParallelToThePlaneMiss) {
 }
 
 TEST(Triangle, RayStartingOnTheTriangle) {
-    Ray ray{Point3(0.5, 0.5, 0), Vector3(0.3, 0.1, 1)};
-    const std::optional<Hit> hit = kUnitTriangle.intersect(ray);
-    ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 0.0);
-    ray.t_min = 1e-12;
-    EXPECT_FALSE(kUnitTriangle.intersect(ray));
+    test::expect_hit_only_at_start(kUnitTriangle, Ray{Point3(0.5, 0.5, 0), Vector3(0.3, 0.1, 1)});
 }
 
 TEST(Triangle, IntervalHonouredAtBothEnds) {

@@ -11,6 +11,7 @@
 #include "csgrt/csg/scene.h"
 #include "csgrt/csg/scene_file.h"
 #include "csgrt/render/renderer.h"
+#include "render/scenes.h"
 
 namespace csgrt {
 namespace {
@@ -18,10 +19,7 @@ namespace {
 // The floor y = 0, white (albedo 1), seen at `target` by a 1-pixel render from below every
 // occluder: its radiance is E / pi for the irradiance E the lights give there.
 Vector3 floor_radiance(Scene scene, const Point3& target) {
-    Camera camera;
-    camera.position = target + Vector3(0.0, 0.5, 2.0);
-    camera.look_at = target;
-    scene.set_camera(camera);
+    test::set_view(scene, target + Vector3(0.0, 0.5, 2.0), target);
     scene.commit();
     RenderSettings settings;
     settings.width = 1;
@@ -172,10 +170,7 @@ TEST(AreaLight, RendersAreTheSameWhateverTheThreads) {
                                    Vector3::Constant(5.0), 9});
     scene.add_light(DiskLight{Point3(2, 2, 0), Vector3(-1, -1, 0), 0.5, Vector3::Constant(3.0), 7});
     scene.add_light(SphereLight{Point3(-2, 2, 1), 0.3, Vector3::Constant(20.0), 16});
-    Camera camera;
-    camera.position = Point3(0, 2, 4);
-    camera.look_at = Point3(0, 0.3, 0);
-    scene.set_camera(camera);
+    test::set_view(scene, Point3(0, 2, 4), Point3(0, 0.3, 0));
     scene.commit();
     RenderSettings settings;
     settings.width = 24;

@@ -10,45 +10,16 @@
 #include <vector>
 
 #include "csgrt/render/command_line.h"
+#include "render/command_line_run.h"
 
 namespace csgrt {
 namespace {
 
+using test::kCommandLineScene;
+using test::ProgramRun;
+using test::run_program;
+
 namespace fs = std::filesystem;
-
-struct JsonRun {
-    int status;
-    std::string out;
-    std::string err;
-};
-
-JsonRun run_program(std::vector<std::string> arguments) {
-    arguments.insert(arguments.begin(), "csgrt");
-    std::vector<const char*> argv;
-    for (const std::string& argument : arguments) argv.push_back(argument.c_str());
-    std::ostringstream out, err;
-    const int status =
-        run_csgrt(static_cast<int>(argv.size()), argv.data(), CommandLineStreams{out, err});
-    return {status, out.str(), err.str()};
-}
-
-/// A plane, a box minus a sphere, and a union of an instanced sphere and a sphere: 8 shapes
-/// counted by hand, 3 top-level objects of which the plane is unbounded, 2 lights.
-constexpr const char* kScene = R"({
-  "camera": {"position": [0, 2, 6], "look_at": [0, 0.5, 0]},
-  "materials": {"red": {"albedo": [0.8, 0.2, 0.2]}},
-  "lights": [{"type": "point", "position": [3, 5, 4], "intensity": [120, 120, 120]},
-             {"type": "directional", "direction": [0, -1, 0]}],
-  "objects": [
-    {"type": "plane", "normal": [0, 1, 0]},
-    {"type": "difference", "material": "red", "operands": [
-        {"type": "box", "lower": [-1, 0, -1], "upper": [1, 2, 1]},
-        {"type": "sphere", "center": [0, 2, 0], "radius": 1.2}]},
-    {"type": "union", "operands": [
-        {"type": "sphere", "radius": 0.4, "transform": [{"translate": [2, 0.4, 0]}]},
-        {"type": "sphere", "center": [2, 0.9, 0], "radius": 0.3}]}
-  ]
-})";
 
 class CommandLineJson : public ::testing::Test {
 protected:
@@ -59,14 +30,14 @@ protected:
         fs::remove_all(directory_);
         fs::create_directories(directory_);
         scene_ = (directory_ / "scene.json").string();
-        std::ofstream(scene_) << kScene;
+        std::ofstream(scene_) << kCommandLineScene;
     }
     fs::path directory_;
     std::string scene_;
 };
 
 TEST_F(CommandLineJson, InfoIsOneObjectWithTheCountsOfTheTree) {
-    const JsonRun result = run_program({"info", scene_, "--json"});
+    const ProgramRun result = run_program({"info", scene_, "--json"});
     ASSERT_EQ(result.status, 0) << result.err;
     EXPECT_EQ(result.err, "");
     const nlohmann::json info = nlohmann::json::parse(result.out);  // throws unless one object
@@ -95,8 +66,8 @@ TEST_F(CommandLineJson, InfoIsOneObjectWithTheCountsOfTheTree) {
 
 TEST_F(CommandLineJson, TheRenderSummaryIsOneObjectWithTheRayCounts) {
     const std::string output = (directory_ / "out.exr").string();
-    const JsonRun result = run_program({"render", scene_, "-o", output, "--width", "40", "--height",
-                                        "30", "--spp", "4", "--json"});
+    const ProgramRun result = run_program({"render", scene_, "-o", output, "--width", "40",
+                                           "--height", "30", "--spp", "4", "--json"});
     ASSERT_EQ(result.status, 0) << result.err;
     const nlohmann::json summary = nlohmann::json::parse(result.out);
     EXPECT_EQ(summary["width"], 40);
@@ -119,7 +90,7 @@ TEST_F(CommandLineJson, UsageErrorsExitWithStatusTwoAndHelpNamesTheInstalledDocs
     EXPECT_EQ(run_program({"info", scene_, "--json", "--bogus"}).status, 2);
     EXPECT_EQ(run_program({"render", scene_, "-o", output, "--threads", "1025"}).status, 2);
     EXPECT_EQ(run_program({"info", (directory_ / "none.json").string()}).status, 2);
-    const JsonRun help = run_program({"--help"});
+    const ProgramRun help = run_program({"--help"});
     EXPECT_EQ(help.status, 0);
     EXPECT_NE(help.out.find("man csgrt"), std::string::npos) << help.out;
     EXPECT_NE(help.out.find("share/doc/csgrt"), std::string::npos) << help.out;

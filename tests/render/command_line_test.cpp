@@ -19,60 +19,19 @@
 
 #include "csgrt/accel/factory.h"
 #include "csgrt/render/exr.h"
+#include "render/command_line_run.h"
+#include "support/test_output.h"
 
 namespace csgrt {
 namespace {
 
+using test::fresh_directory;
+using test::kCommandLineScene;
+using test::names_in;
+using test::ProgramRun;
+using test::run_program;
+
 namespace fs = std::filesystem;
-
-fs::path fresh_directory(const std::string& name) {
-    const fs::path path = fs::path(CSGRT_BINARY_DIR) / "test_output" / name;
-    fs::remove_all(path);
-    fs::create_directories(path);
-    return path;
-}
-
-std::vector<std::string> names_in(const fs::path& directory) {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(directory)) {
-        names.push_back(entry.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
-/// A small scene: a ground plane, a CSG difference, and an instanced sphere in a union.
-constexpr const char* kSceneText = R"({
-  "camera": {"position": [0, 2, 6], "look_at": [0, 0.5, 0]},
-  "materials": {"red": {"albedo": [0.8, 0.2, 0.2]}},
-  "lights": [{"type": "point", "position": [3, 5, 4], "intensity": [120, 120, 120]},
-             {"type": "directional", "direction": [0, -1, 0]}],
-  "objects": [
-    {"type": "plane", "normal": [0, 1, 0]},
-    {"type": "difference", "material": "red", "operands": [
-        {"type": "box", "lower": [-1, 0, -1], "upper": [1, 2, 1]},
-        {"type": "sphere", "center": [0, 2, 0], "radius": 1.2}]},
-    {"type": "union", "operands": [
-        {"type": "sphere", "radius": 0.4, "transform": [{"translate": [2, 0.4, 0]}]},
-        {"type": "sphere", "center": [2, 0.9, 0], "radius": 0.3}]}
-  ]
-})";
-
-struct ProgramRun {
-    int status;
-    std::string out;
-    std::string err;
-};
-
-ProgramRun run(std::vector<std::string> arguments) {
-    arguments.insert(arguments.begin(), "csgrt");
-    std::vector<const char*> argv;
-    for (const std::string& argument : arguments) argv.push_back(argument.c_str());
-    std::ostringstream out, err;
-    const int status =
-        run_csgrt(static_cast<int>(argv.size()), argv.data(), CommandLineStreams{out, err});
-    return {status, out.str(), err.str()};
-}
 
 /// An error run: exit status `status` (1: the scene or the render failed; 2: a usage error),
 /// nothing on stdout, exactly one line on stderr that starts with "csgrt: error: " and
@@ -94,7 +53,7 @@ protected:
         directory_ = fresh_directory(
             std::string("cli_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
         scene_ = (directory_ / "scene.json").string();
-        std::ofstream(scene_) << kSceneText;
+        std::ofstream(scene_) << kCommandLineScene;
         output_ = (directory_ / "out.exr").string();
     }
     /// Only the scene file: no output, complete or partial, was left behind.
@@ -108,8 +67,8 @@ protected:
 };
 
 TEST_F(CommandLine, RenderWritesTheExrAndPreviewsAndOneSummaryLine) {
-    const ProgramRun result = run({"render", scene_, "-o", output_, "--width", "40", "--height",
-                                   "30", "--spp", "4", "--threads", "2"});
+    const ProgramRun result = run_program({"render", scene_, "-o", output_, "--width", "40",
+                                           "--height", "30", "--spp", "4", "--threads", "2"});
     ASSERT_EQ(result.status, 0) << result.err;
     EXPECT_EQ(result.err, "");  // not a terminal: no progress bar
     EXPECT_EQ(std::count(result.out.begin(), result.out.end(), '\n'), 1) << result.out;
@@ -135,15 +94,15 @@ TEST_F(CommandLine, RenderWritesTheExrAndPreviewsAndOneSummaryLine) {
 }
 
 TEST_F(CommandLine, EveryAvailableStructureRendersTheSameImage) {
-    ASSERT_EQ(run({"render", scene_, "-o", output_, "--width", "32", "--height", "24", "--accel",
-                   "brute"})
+    ASSERT_EQ(run_program({"render", scene_, "-o", output_, "--width", "32", "--height", "24",
+                           "--accel", "brute"})
                   .status,
               0);
     const ExrFile reference = read_exr(output_);
     for (std::string_view name : accelerator_names()) {
         const std::string other = (directory_ / (std::string(name) + ".exr")).string();
-        ASSERT_EQ(run({"render", scene_, "-o", other, "--width", "32", "--height", "24", "--accel",
-                       std::string(name)})
+        ASSERT_EQ(run_program({"render", scene_, "-o", other, "--width", "32", "--height", "24",
+                               "--accel", std::string(name)})
                       .status,
                   0)
             << name;
@@ -189,14 +148,15 @@ TEST_F(CommandLine, BadArgumentsGiveOneLineAndNoFiles) {
     };
     for (const auto& [arguments, fragment] : cases) {
         SCOPED_TRACE(::testing::PrintToString(arguments));
-        expect_one_line_error(run(arguments), fragment, 2);
+        expect_one_line_error(run_program(arguments), fragment, 2);
     }
     expect_no_output();
 }
 
 TEST_F(CommandLine, StatsPrintsATableOfRaysHitsWorkAndTimes) {
-    const ProgramRun result = run({"render", scene_, "-o", output_, "--width", "20", "--height",
-                                   "10", "--accel", "brute", "--stats", "--tonemap", "reinhard"});
+    const ProgramRun result =
+        run_program({"render", scene_, "-o", output_, "--width", "20", "--height", "10", "--accel",
+                     "brute", "--stats", "--tonemap", "reinhard"});
     ASSERT_EQ(result.status, 0) << result.err;
     for (const char* fragment :
          {"Rays", "camera", "shadow", "% blocked", "Camera-ray hits", "Top-level structure (brute)",
@@ -209,8 +169,8 @@ TEST_F(CommandLine, StatsPrintsATableOfRaysHitsWorkAndTimes) {
         << result.out;
     // Without --timing-in-header the EXR holds no timing; with it, it does.
     EXPECT_FALSE(read_exr(output_).metadata.include_timing);
-    ASSERT_EQ(run({"render", scene_, "-o", output_, "--width", "8", "--height", "8",
-                   "--timing-in-header"})
+    ASSERT_EQ(run_program({"render", scene_, "-o", output_, "--width", "8", "--height", "8",
+                           "--timing-in-header"})
                   .status,
               0);
     EXPECT_TRUE(read_exr(output_).metadata.include_timing);
@@ -218,8 +178,8 @@ TEST_F(CommandLine, StatsPrintsATableOfRaysHitsWorkAndTimes) {
 }
 
 TEST_F(CommandLine, CostAllWritesALayerPerStructureAndTheirContactSheet) {
-    const ProgramRun result = run({"render", scene_, "-o", output_, "--width", "12", "--height",
-                                   "8", "--cost-all", "--stats"});
+    const ProgramRun result = run_program({"render", scene_, "-o", output_, "--width", "12",
+                                           "--height", "8", "--cost-all", "--stats"});
     ASSERT_EQ(result.status, 0) << result.err;
     EXPECT_EQ(names_in(directory_), (std::vector<std::string>{"out.cost-all.png", "out.cost.png",
                                                               "out.exr", "out.png", "scene.json"}));
@@ -255,7 +215,7 @@ TEST_F(CommandLine, EveryDocumentedStructureRendersTheSameImage) {
     // docs/rendering.md and --help name these; each must be registered and render the scene
     // (pixel-level equality of the structures is checked in renderer_test.cpp).
     for (const char* name : {"brute", "bvh", "grid", "hgrid", "rayclass"}) {
-        const ProgramRun rendered = run(
+        const ProgramRun rendered = run_program(
             {"render", scene_, "-o", output_, "--width", "8", "--height", "8", "--accel", name});
         EXPECT_EQ(rendered.status, 0) << name << ": " << rendered.err;
         EXPECT_TRUE(fs::exists(output_)) << name;
@@ -269,34 +229,34 @@ TEST_F(CommandLine, EveryDocumentedStructureRendersTheSameImage) {
 TEST_F(CommandLine, ABrokenSceneFileIsOneLineNamingTheFileAndWritesNothing) {
     const std::string broken = (directory_ / "broken.json").string();
     std::ofstream(broken) << R"({"objects": [{"type": "sphere", "radius": -1}]})";
-    const ProgramRun rendered = run({"render", broken, "-o", output_});
+    const ProgramRun rendered = run_program({"render", broken, "-o", output_});
     expect_one_line_error(rendered, "broken.json");
     expect_one_line_error(rendered, "radius");
-    expect_one_line_error(run({"validate", broken}), "/objects/0/radius");
-    expect_one_line_error(run({"info", broken}), "broken.json");
+    expect_one_line_error(run_program({"validate", broken}), "/objects/0/radius");
+    expect_one_line_error(run_program({"info", broken}), "broken.json");
     fs::remove(broken);
     expect_no_output();
 }
 
 TEST_F(CommandLine, AnOutputThatIsADirectoryIsRefusedBeforeRendering) {
     fs::create_directory(directory_ / "out.png");
-    expect_one_line_error(run({"render", scene_, "-o", output_}), "is a directory", 2);
+    expect_one_line_error(run_program({"render", scene_, "-o", output_}), "is a directory", 2);
     EXPECT_EQ(names_in(directory_), (std::vector<std::string>{"out.png", "scene.json"}));
 }
 
 TEST_F(CommandLine, AnOutputThatIsTheSceneIsRefusedInEverySpelling) {
     // A scene named .exr (valid JSON): rendering onto it would replace the scene.
     const fs::path scene = directory_ / "scene.exr";
-    std::ofstream(scene) << kSceneText;
+    std::ofstream(scene) << kCommandLineScene;
     const fs::path other_spelling = directory_ / ".." / directory_.filename() / "." / "scene.exr";
     fs::create_symlink(scene, directory_ / "link.exr");
     for (const fs::path& output : {scene, other_spelling, directory_ / "link.exr"}) {
-        const ProgramRun result = run({"render", scene.string(), "-o", output.string()});
+        const ProgramRun result = run_program({"render", scene.string(), "-o", output.string()});
         expect_one_line_error(result, "is the scene file", 2);  // a usage error
     }
     std::ifstream in(scene);
     const std::string kept{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    EXPECT_EQ(kept, kSceneText);
+    EXPECT_EQ(kept, kCommandLineScene);
     fs::remove(scene);
     fs::remove(directory_ / "link.exr");
     expect_no_output();
@@ -308,14 +268,14 @@ TEST_F(CommandLine, AnUnwritableOutputFolderIsRefusedBeforeRendering) {
     // The folder is a regular file, or a folder on its path is.
     std::ofstream(directory_ / "file.txt") << "x";
     expect_one_line_error(
-        run({"render", scene_, "-o", (directory_ / "file.txt" / "out.exr").string()}),
+        run_program({"render", scene_, "-o", (directory_ / "file.txt" / "out.exr").string()}),
         "file.txt' is not a directory", 2);
-    expect_one_line_error(
-        run({"render", scene_, "-o", (directory_ / "file.txt" / "sub" / "out.exr").string()}),
-        "sub' is not a directory: a folder on its path is a file", 2);
+    expect_one_line_error(run_program({"render", scene_, "-o",
+                                       (directory_ / "file.txt" / "sub" / "out.exr").string()}),
+                          "sub' is not a directory: a folder on its path is a file", 2);
     // sysfs takes no new files, whoever asks (EACCES, or EROFS where it is mounted read-only).
     if (fs::is_directory("/sys")) {
-        expect_one_line_error(run({"render", scene_, "-o", "/sys/out.exr"}),
+        expect_one_line_error(run_program({"render", scene_, "-o", "/sys/out.exr"}),
                               "output directory '/sys' is not writable: ", 2);
         EXPECT_FALSE(fs::exists("/sys/out.exr"));
     }
@@ -324,7 +284,8 @@ TEST_F(CommandLine, AnUnwritableOutputFolderIsRefusedBeforeRendering) {
     fs::create_directory(folder);
     fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec);
     if (::geteuid() != 0) {
-        const ProgramRun result = run({"render", scene_, "-o", (folder / "out.exr").string()});
+        const ProgramRun result =
+            run_program({"render", scene_, "-o", (folder / "out.exr").string()});
         expect_one_line_error(result, "' is not writable: Permission denied", 2);
     }
     fs::permissions(folder, fs::perms::owner_all);
@@ -393,7 +354,7 @@ TEST_F(CommandLine, InfoCountsAnExpansionOfAMillionLeavesWithoutWalkingIt) {
     }
     std::ofstream(scene_, std::ios::trunc)
         << text << R"(}, "objects": [{"type": "ref", "definition": "d20"}]})";
-    const ProgramRun result = run({"info", scene_});
+    const ProgramRun result = run_program({"info", scene_});
     ASSERT_EQ(result.status, 0) << result.err;
     for (const char* fragment :
          {"2097151 shapes in the trees under them (1048576 leaves)",
@@ -448,14 +409,14 @@ TEST_F(CommandLine, TheProgressBarAppearsOnATerminalOnlyAfterTheDelay) {
 }
 
 TEST_F(CommandLine, ValidatePrintsNothingForAGoodScene) {
-    const ProgramRun result = run({"validate", scene_});
+    const ProgramRun result = run_program({"validate", scene_});
     EXPECT_EQ(result.status, 0);
     EXPECT_EQ(result.out, "");
     EXPECT_EQ(result.err, "");
 }
 
 TEST_F(CommandLine, InfoCountsKindsThroughTheTree) {
-    const ProgramRun result = run({"info", scene_});
+    const ProgramRun result = run_program({"info", scene_});
     ASSERT_EQ(result.status, 0) << result.err;
     // plane; difference(box, sphere); union(instance(sphere), sphere): 8 shapes.
     for (const char* fragment :
@@ -479,7 +440,7 @@ TEST_F(CommandLine, InfoReportsTheShowcasesMeshWithItsTriangleCount) {
     off >> magic >> vertices >> faces;
     ASSERT_EQ(magic, "OFF");
     ASSERT_GT(faces, 100u);
-    const ProgramRun result = run({"info", (scenes / "showcase.json").string()});
+    const ProgramRun result = run_program({"info", (scenes / "showcase.json").string()});
     ASSERT_EQ(result.status, 0) << result.err;
     EXPECT_NE(result.out.find("  mesh               1 (" + std::to_string(faces) +
                               " triangles in all)\n"),
@@ -523,7 +484,7 @@ TEST_F(CommandLine, InfoSaysForEachMeshWhetherItIsClosed) {
         {"type": "mesh", "path": "cube.off", "transform": [{"translate": [3, 0, 0]}]},
         {"type": "mesh", "path": "soup.off"},
         {"type": "mesh", "path": "soup.off", "weld": true, "name": "welded"}]})";
-    const ProgramRun result = run({"info", scene_});
+    const ProgramRun result = run_program({"info", scene_});
     ASSERT_EQ(result.status, 0) << result.err;
     for (const char* fragment :
          {"meshes:     3 closed (solids: CSG operands, inside/outside), 2 open\n",
@@ -542,7 +503,7 @@ TEST_F(CommandLine, InfoSaysForEachMeshWhetherItIsClosed) {
     // Four distinct meshes, four lines: the cube used twice is listed once.
     EXPECT_EQ(result.out.find("  object 2:"), std::string::npos) << result.out;
 
-    const ProgramRun json = run({"info", scene_, "--json"});
+    const ProgramRun json = run_program({"info", scene_, "--json"});
     ASSERT_EQ(json.status, 0) << json.err;
     const nlohmann::json meshes = nlohmann::json::parse(json.out)["meshes"];
     ASSERT_EQ(meshes.size(), 4u) << meshes;
@@ -561,17 +522,17 @@ TEST_F(CommandLine, InfoSaysForEachMeshWhetherItIsClosed) {
 }
 
 TEST_F(CommandLine, HelpAndVersionSucceed) {
-    const ProgramRun help = run({"--help"});
+    const ProgramRun help = run_program({"--help"});
     EXPECT_EQ(help.status, 0);
     for (const char* fragment : {"render", "info", "validate", "Examples:"}) {
         EXPECT_NE(help.out.find(fragment), std::string::npos) << fragment;
     }
-    const ProgramRun render_help = run({"render", "--help"});
+    const ProgramRun render_help = run_program({"render", "--help"});
     EXPECT_EQ(render_help.status, 0);
     for (const char* fragment : {"--width", "--spp", "--threads", "--accel", "auto", "cost"}) {
         EXPECT_NE(render_help.out.find(fragment), std::string::npos) << fragment;
     }
-    const ProgramRun version = run({"--version"});
+    const ProgramRun version = run_program({"--version"});
     EXPECT_EQ(version.status, 0);
     EXPECT_EQ(version.out.rfind("csgrt ", 0), 0u);
 }

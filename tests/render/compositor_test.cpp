@@ -18,18 +18,14 @@
 #include "csgrt/render/exr.h"
 #include "csgrt/render/renderer.h"
 #include "render/scenes.h"
+#include "support/test_output.h"
 
 namespace csgrt {
 namespace {
 
-namespace fs = std::filesystem;
+using test::fresh_directory;
 
-fs::path fresh_directory(const std::string& name) {
-    const fs::path path = fs::path(CSGRT_BINARY_DIR) / "test_output" / name;
-    fs::remove_all(path);
-    fs::create_directories(path);
-    return path;
-}
+namespace fs = std::filesystem;
 
 /// The full path of `tool` on PATH, or empty.
 fs::path find_tool(const std::string& tool) {

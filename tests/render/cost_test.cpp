@@ -248,10 +248,7 @@ TEST(CostLayers, EveryStructureOfTheSceneIsRebuiltAndSharedShapesStayShared) {
     scene.add_object(
         make_difference(std::make_shared<Instance>(mesh, Transform::translate(Vector3(0, -1.5, 0))),
                         {std::make_shared<Sphere>(Point3(0.5, -1.5, 0.5), 0.6)}));
-    Camera camera;
-    camera.position = Point3(0.2, 0.3, 6.0);
-    camera.look_at = Point3(0, 0, 0);
-    scene.set_camera(camera);
+    test::set_view(scene, Point3(0.2, 0.3, 6.0), Point3(0, 0, 0));
     SceneConfig config;
     config.accelerator = "bvh";
     scene.commit(config);

@@ -26,25 +26,13 @@
 #include <string>
 #include <vector>
 
+#include "support/test_output.h"
+
 namespace csgrt {
 namespace {
 
-std::filesystem::path fresh_directory(const std::string& name) {
-    const std::filesystem::path path =
-        std::filesystem::path(CSGRT_BINARY_DIR) / "test_output" / name;
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-    return path;
-}
-
-std::vector<std::string> names_in(const std::filesystem::path& directory) {
-    std::vector<std::string> names;
-    for (const auto& entry : std::filesystem::directory_iterator(directory)) {
-        names.push_back(entry.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
+using test::fresh_directory;
+using test::names_in;
 
 /// A 5 x 3 image whose every channel varies per pixel, with background pixels mixed in.
 Image sample_image() {

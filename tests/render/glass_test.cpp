@@ -14,6 +14,7 @@
 #include "csgrt/render/materials.h"
 #include "csgrt/render/renderer.h"
 #include "csgrt/render/shadow_offset.h"
+#include "render/scenes.h"
 #include "support/random.h"
 
 namespace csgrt {
@@ -49,12 +50,7 @@ TEST(Glass, ABallLensFocusesAtTheLensMakersFocalLength) {
         scene.add_object(
             std::make_shared<Disk>(Point3(0, 0, -target), Normal3(0, 0, 1), target_radius),
             scene.add_material(Material{"white", Vector3(1, 1, 1)}));
-        Camera camera;
-        camera.projection = Camera::Projection::Orthographic;
-        camera.position = Point3(0, 0, 5);
-        camera.look_at = Point3(0, 0, 0);
-        camera.orthographic_height = 0.1;
-        scene.set_camera(camera);
+        test::set_orthographic_view(scene, Point3(0, 0, 5), Point3(0, 0, 0), 0.1);
         scene.commit();
         RenderSettings settings;
         settings.width = 9;

@@ -14,6 +14,7 @@
 #include "csgrt/csg/scene.h"
 #include "csgrt/csg/scene_file.h"
 #include "csgrt/render/renderer.h"
+#include "render/scenes.h"
 
 namespace csgrt {
 namespace {
@@ -103,10 +104,7 @@ TEST(Mirror, ImagesAPointWhereGeometrySays) {
     const auto grey = scene.add_material(Material{"grey", Vector3::Constant(0.5)});
     scene.add_object(std::make_shared<Plane>(Point3(0, 0, 0), Normal3(0, 1, 0)), mirror_index);
     scene.add_object(std::make_shared<Sphere>(Point3(0, 1, -3), 0.5), grey);
-    Camera camera;
-    camera.position = Point3(0, 1, 3);
-    camera.look_at = Point3(0, -1, -3);
-    scene.set_camera(camera);
+    test::set_view(scene, Point3(0, 1, 3), Point3(0, -1, -3));
     scene.commit();
     RenderSettings settings;
     settings.background = Vector3(0.1, 0.2, 0.3);
@@ -117,8 +115,7 @@ TEST(Mirror, ImagesAPointWhereGeometrySays) {
     EXPECT_EQ(stats.secondary_rays, 1u);
 
     // Aimed at the image of a point beside the ball, the reflection misses: background, dimmed.
-    camera.look_at = Point3(3, -1, -3);
-    scene.set_camera(camera);
+    test::set_view(scene, Point3(0, 1, 3), Point3(3, -1, -3));
     scene.commit();
     const Vector3 missed = centre_pixel(scene, settings);
     EXPECT_NEAR(missed.y(), 0.8 * 0.2, 1e-6);
@@ -137,10 +134,7 @@ TEST(Glass, ASphereSeenThroughItsCentreLosesOnlyTheTruncatedPaths) {
     Material glass{"glass", Vector3::Zero()};
     glass.ior = 1.5;
     scene.add_object(std::make_shared<Sphere>(Point3(0, 0, 0), 1.0), scene.add_material(glass));
-    Camera camera;
-    camera.position = Point3(0, 0, 5);
-    camera.look_at = Point3(0, 0, 0);
-    scene.set_camera(camera);
+    test::set_view(scene, Point3(0, 0, 5), Point3(0, 0, 0));
     scene.commit();
     RenderSettings settings;
     settings.background = Vector3(1.0, 0.5, 0.25);
@@ -161,10 +155,7 @@ TEST(Ambient, AddsAlbedoTimesAmbientUnshadowed) {
     scene.add_object(std::make_shared<Sphere>(Point3(0, 0, 0), 1.0), grey);
     // A light behind the ball: the side the camera sees gets nothing but the ambient term.
     scene.add_light(PointLight{Point3(0, 0, -10), Vector3::Constant(100.0)});
-    Camera camera;
-    camera.position = Point3(0, 0, 5);
-    camera.look_at = Point3(0, 0, 0);
-    scene.set_camera(camera);
+    test::set_view(scene, Point3(0, 0, 5), Point3(0, 0, 0));
     scene.commit();
     RenderSettings settings;
     settings.ambient = Vector3(0.2, 0.4, 0.0);
@@ -230,10 +221,7 @@ TEST(PointLight, FallsOffWithTheChosenPowerOfDistance) {
         PointLight light{Point3(0, 0, height), Vector3::Constant(1.0)};
         light.falloff = falloff;
         scene.add_light(light);
-        Camera camera;
-        camera.position = Point3(0, 0, 1);
-        camera.look_at = Point3(0, 0, 0);
-        scene.set_camera(camera);
+        test::set_view(scene, Point3(0, 0, 1), Point3(0, 0, 0));
         scene.commit();
         return centre_pixel(scene, RenderSettings{}).x();
     };
@@ -307,12 +295,7 @@ TEST(CsgMaterials, EachOperandShowsItsOwnAndACutShowsTheSubtractedOne) {
         std::make_shared<Painted>(std::make_shared<Sphere>(Point3(1, 1, 1), 0.5), blue);
     const auto slot = std::make_shared<Box>(Point3(0.1, 0.4, 0.5), Point3(0.2, 0.6, 2));
     scene.add_object(make_difference(box, {ball, slot}), green);
-    Camera camera;
-    camera.projection = Camera::Projection::Orthographic;
-    camera.position = Point3(0.5, 0.5, 5);
-    camera.look_at = Point3(0.5, 0.5, 0);
-    camera.orthographic_height = 1.0;
-    scene.set_camera(camera);
+    test::set_orthographic_view(scene, Point3(0.5, 0.5, 5), Point3(0.5, 0.5, 0), 1.0);
     scene.commit();
     RenderSettings settings;
     settings.width = 10;

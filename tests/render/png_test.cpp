@@ -10,17 +10,12 @@
 #include <limits>
 #include <vector>
 
+#include "support/test_output.h"
+
 namespace csgrt {
 namespace {
 
-/// A fresh, empty directory under the build tree for one test's files.
-std::filesystem::path fresh_directory(const std::string& name) {
-    const std::filesystem::path path =
-        std::filesystem::path(CSGRT_BINARY_DIR) / "test_output" / name;
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-    return path;
-}
+using test::fresh_directory;
 
 /// An 8-bit RGB PNG read with libpng's simplified API.
 struct Rgb8 {

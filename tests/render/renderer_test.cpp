@@ -113,8 +113,8 @@ TEST(Render, EveryPixelsIdDepthAndNormalMatchAnAnalyticTraceOfTheSpheres) {
         int compared = 0, background = 0;
         for (int y = 0; y < height; ++y) {
             for (int x = 0; x < width; ++x) {
-                const TestRay ray = camera_ray(camera, (x + 0.5L) / width, (y + 0.5L) / height,
-                                               (long double)width / height);
+                const TestRay ray = camera_ray(scene.camera(), (x + 0.5L) / width,
+                                               (y + 0.5L) / height, (long double)width / height);
                 long double best = -1, margin = 1;
                 std::uint32_t best_id = kNoIndex;
                 for (std::uint32_t id = 0; id < spheres.size(); ++id) {
@@ -188,10 +188,7 @@ TEST(Render, HardShadowOfASphereOnAPlaneIsExactlyWhereTheSphereBlocksTheLight) {
     scene.add_object(std::make_shared<Plane>(Point3(0, 0, 0), Normal3(0, 1, 0)));  // albedo 0.8
     scene.add_object(std::make_shared<Sphere>(Point3(0, 1, 0), 0.5));
     scene.add_light(DirectionalLight{Vector3(0, -1, 0), Vector3(1, 1, 1)});
-    Camera camera;
-    camera.position = Point3(0, 4, 6);
-    camera.look_at = Point3(0, 0, 0);
-    scene.set_camera(camera);
+    test::set_view(scene, Point3(0, 4, 6), Point3(0, 0, 0));
     scene.commit();
     const int width = 96, height = 72;
     const Image image = render(scene, small(width, height)).image;
@@ -201,7 +198,7 @@ TEST(Render, HardShadowOfASphereOnAPlaneIsExactlyWhereTheSphereBlocksTheLight) {
         for (int x = 0; x < width; ++x) {
             const Pixel& pixel = image.at(x, y);
             if (pixel.object_id != 0) continue;
-            const TestRay ray = camera_ray(camera, (x + 0.5L) / width, (y + 0.5L) / height,
+            const TestRay ray = camera_ray(scene.camera(), (x + 0.5L) / width, (y + 0.5L) / height,
                                            (long double)width / height);
             const auto point = ray.origin + (long double)pixel.depth * ray.direction;
             // Straight down: the point is in shadow when it lies under the sphere's disc.

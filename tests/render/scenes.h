@@ -9,6 +9,26 @@
 
 namespace csgrt::test {
 
+/// Gives `scene` the default pinhole camera at `position` looking at `look_at`.
+inline void set_view(Scene& scene, const Point3& position, const Point3& look_at) {
+    Camera camera;
+    camera.position = position;
+    camera.look_at = look_at;
+    scene.set_camera(camera);
+}
+
+/// Gives `scene` an orthographic camera at `position` looking at `look_at`, whose view is
+/// `height` tall.
+inline void set_orthographic_view(Scene& scene, const Point3& position, const Point3& look_at,
+                                  double height) {
+    Camera camera;
+    camera.projection = Camera::Projection::Orthographic;
+    camera.position = position;
+    camera.look_at = look_at;
+    camera.orthographic_height = height;
+    scene.set_camera(camera);
+}
+
 /// Three spheres of different colours on a ground plane (y = 0), lit by a point light and a
 /// directional light: shading, hard shadows and object ids in one small scene.
 inline Scene spheres_on_a_plane() {
@@ -45,12 +65,7 @@ inline Scene csg_solids() {
     auto b = std::make_shared<Sphere>(Point3(2.7, 0.5, 0.2), 0.5);
     scene.add_object(make_union({a, b}), white, "blob");
     scene.add_light(PointLight{Point3(3, 5, 6), Vector3(200, 200, 200)});
-    Camera camera;
-    camera.projection = Camera::Projection::Orthographic;
-    camera.position = Point3(2.5, 2.0, 5.0);
-    camera.look_at = Point3(0.9, 0.1, 0.0);
-    camera.orthographic_height = 4.8;
-    scene.set_camera(camera);
+    test::set_orthographic_view(scene, Point3(2.5, 2.0, 5.0), Point3(0.9, 0.1, 0.0), 4.8);
     return scene;
 }
 

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
+#include <optional>
 #include <vector>
 
 #include "csgrt/core/ray.h"
@@ -53,6 +55,35 @@ inline void expect_interval_honoured(const Shape& shape, const Ray& ray, double 
     clipped.t_min = std::nextafter(t, 2.0 * t);
     EXPECT_FALSE(shape.intersect(clipped));
     EXPECT_FALSE(shape.occluded(clipped));
+}
+
+/// No query of `shape` reports anything for any invalid variant of the valid ray `valid`
+/// (invalid_variants): no hit, no occlusion, no span.
+inline void expect_invalid_rays_miss(const Shape& shape, const Ray& valid) {
+    for (const Ray& ray : invalid_variants(valid)) {
+        EXPECT_FALSE(shape.intersect(ray)) << shape.kind();
+        EXPECT_FALSE(shape.occluded(ray)) << shape.kind();
+        EXPECT_TRUE(shape.spans(ray).empty()) << shape.kind();
+    }
+}
+
+/// Each of `rays` misses `shape`: no hit and no occlusion.
+inline void expect_misses(const Shape& shape, std::initializer_list<Ray> rays) {
+    for (const Ray& ray : rays) {
+        EXPECT_FALSE(shape.intersect(ray)) << shape.kind();
+        EXPECT_FALSE(shape.occluded(ray)) << shape.kind();
+    }
+}
+
+/// `ray` starts on the surface of the flat (or otherwise once-crossed) `shape` and leaves it:
+/// it hits at t = 0 exactly, and from t_min = 1e-12 on it meets nothing.
+inline void expect_hit_only_at_start(const Shape& shape, Ray ray) {
+    const std::optional<Hit> hit = shape.intersect(ray);
+    ASSERT_TRUE(hit) << shape.kind();
+    EXPECT_EQ(hit->t, 0.0) << shape.kind();
+    ray.t_min = 1e-12;
+    EXPECT_FALSE(shape.intersect(ray)) << shape.kind();
+    EXPECT_FALSE(shape.occluded(ray)) << shape.kind();
 }
 
 }  // namespace csgrt::test
