@@ -27,9 +27,9 @@ Aabb Annulus::bounds() const {
 
 std::optional<Crossing> Annulus::crossing(const Ray& ray) const {
     double t;
-    if (!detail::plane_crossing(ray, center_, frame_.normal, t) || !ray.in_range(t)) return {};
+    Vector3 offset;
+    if (!detail::plane_offset(ray, center_, frame_.normal, t, offset)) return {};
     // Squared distances against squared radii, as for the disk: no square root.
-    const Vector3 offset = (ray.origin - center_) + t * ray.direction;
     const double squared = offset.squaredNorm();
     if (squared > outer_radius_ * outer_radius_ || squared < inner_radius_ * inner_radius_)
         return {};

@@ -21,10 +21,9 @@ Aabb Disk::bounds() const {
 
 std::optional<Crossing> Disk::crossing(const Ray& ray) const {
     double t;
-    if (!detail::plane_crossing(ray, center_, frame_.normal, t) || !ray.in_range(t)) return {};
-    // Compare squared distances: no square root (the point the seed makes). The offset is
-    // formed as (o - c) + t d, which keeps it accurate when o and c are large but close.
-    const Vector3 offset = (ray.origin - center_) + t * ray.direction;
+    Vector3 offset;
+    if (!detail::plane_offset(ray, center_, frame_.normal, t, offset)) return {};
+    // Compare squared distances: no square root (the point the seed makes).
     if (!(offset.squaredNorm() <= radius_ * radius_)) return {};
     return Crossing{.t = t};
 }

@@ -20,6 +20,16 @@ inline SurfaceFrame frame_of_normal(const Normal3& normal, const char* shape) {
     return SurfaceFrame::around(unit);
 }
 
+/// Where the ray crosses the plane through `anchor` with unit normal `normal`, at some t in
+/// [t_min, t_max], and that point's offset from the anchor, formed as (o - anchor) + t d, which
+/// keeps it accurate when o and the anchor are large but close. False when there is none.
+inline bool plane_offset(const Ray& ray, const Point3& anchor, const Normal3& normal, double& t,
+                         Vector3& offset) {
+    if (!plane_crossing(ray, anchor, normal, t) || !ray.in_range(t)) return false;
+    offset = (ray.origin - anchor) + t * ray.direction;
+    return true;
+}
+
 /// The point of a flat shape with unit normal `normal` that lies `offset` from `anchor` as
 /// o + t d gave it: the component along the normal that rounding left is dropped from `offset`
 /// (written back, for the caller's uv) and the point is anchor + offset.

@@ -43,8 +43,8 @@ Aabb Rectangle::bounds() const {
 
 std::optional<Crossing> Rectangle::crossing(const Ray& ray) const {
     double t;
-    if (!detail::plane_crossing(ray, corner_, normal_, t) || !ray.in_range(t)) return {};
-    const Vector3 offset = (ray.origin - corner_) + t * ray.direction;
+    Vector3 offset;
+    if (!detail::plane_offset(ray, corner_, normal_, t, offset)) return {};
     const double s = offset.dot(dual_a_);
     const double r = offset.dot(dual_b_);
     // Closed: edges and corners belong to the parallelogram.
