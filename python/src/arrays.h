@@ -8,7 +8,9 @@
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "csgrt/csg/batch.h"
@@ -49,6 +51,13 @@ py::array_t<T> output(const std::vector<py::ssize_t>& leading,
 template <class T>
 std::span<T> span_of(py::array_t<T>& array) {
     return {array.mutable_data(), static_cast<std::size_t>(array.size())};
+}
+
+/// A dict of named results, in the order given.
+inline py::dict named_results(std::initializer_list<std::pair<const char*, py::object>> results) {
+    py::dict dict;
+    for (const auto& [name, value] : results) dict[name] = value;
+    return dict;
 }
 
 /// Rays of an (..., 6) input (origin, direction) with the interval [t_min, t_max].

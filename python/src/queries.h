@@ -154,15 +154,13 @@ py::dict list_intersections_as(const Target& target, const FloatInput& rays, dou
                             static_cast<std::size_t>(total)};
         list_crossings(target, view, outputs, config);
     }
-    py::dict result;
-    result["ray_splits"] = splits;
-    result["ray_ids"] = ray_ids;
-    result["geometry_ids"] = geometry;
-    result["primitive_ids"] = primitive;
-    result["primitive_uvs"] = uv;
-    result["t_hit"] = t;
-    result["entering"] = entering;
-    return result;
+    return named_results({{"ray_splits", splits},
+                          {"ray_ids", ray_ids},
+                          {"geometry_ids", geometry},
+                          {"primitive_ids", primitive},
+                          {"primitive_uvs", uv},
+                          {"t_hit", t},
+                          {"entering", entering}});
 }
 
 template <class Target>
@@ -223,36 +221,32 @@ void bind_queries(Class& cls, WithTarget with_target, const QueryDocs& docs) {
         },
         "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "outputs"_a = py::none(), "nthreads"_a = 0,
         docs.cast_rays.c_str());
-    cls.def(
+    // The three queries of (rays, tnear, tfar, nthreads), each a generic call of its function.
+    const auto def_ray_query = [&](const char* name, auto query, const std::string& doc) {
+        cls.def(
+            name,
+            [with_target, query](const Self& self, const py::handle& rays, double tnear,
+                                 double tfar, int nthreads) {
+                return with_target(self, [&](const auto& target) {
+                    return query(target, rays, tnear, tfar, nthreads);
+                });
+            },
+            "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0, doc.c_str());
+    };
+    def_ray_query(
         "test_occlusions",
-        [with_target](const Self& self, const py::handle& rays, double tnear, double tfar,
-                      int nthreads) {
-            return with_target(self, [&](const auto& target) {
-                return test_occlusions(target, rays, tnear, tfar, nthreads);
-            });
-        },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
-        docs.test_occlusions.c_str());
-    cls.def(
+        [](const auto& target, const auto&... rest) { return test_occlusions(target, rest...); },
+        docs.test_occlusions);
+    def_ray_query(
         "count_intersections",
-        [with_target](const Self& self, const py::handle& rays, double tnear, double tfar,
-                      int nthreads) {
-            return with_target(self, [&](const auto& target) {
-                return count_intersections(target, rays, tnear, tfar, nthreads);
-            });
+        [](const auto& target, const auto&... rest) {
+            return count_intersections(target, rest...);
         },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
-        docs.count_intersections.c_str());
-    cls.def(
+        docs.count_intersections);
+    def_ray_query(
         "list_intersections",
-        [with_target](const Self& self, const py::handle& rays, double tnear, double tfar,
-                      int nthreads) {
-            return with_target(self, [&](const auto& target) {
-                return list_intersections(target, rays, tnear, tfar, nthreads);
-            });
-        },
-        "rays"_a, "tnear"_a = 0.0, "tfar"_a = kInfinity, "nthreads"_a = 0,
-        docs.list_intersections.c_str());
+        [](const auto& target, const auto&... rest) { return list_intersections(target, rest...); },
+        docs.list_intersections);
     cls.def(
         "compute_occupancy",
         [with_target](const Self& self, const py::handle& points, int nthreads, int nsamples) {

@@ -144,13 +144,11 @@ py::dict closest_points_as(const TriangleStructure<float>& target, const FloatIn
         py::gil_scoped_release release;
         closest_points(target, point_arrays<Real>(points), outputs, config);
     }
-    py::dict result;
-    result["points"] = point;
-    result["geometry_ids"] = geometry;
-    result["primitive_ids"] = primitive;
-    result["primitive_uvs"] = uv;
-    result["primitive_normals"] = normal;
-    return result;
+    return named_results({{"points", point},
+                          {"geometry_ids", geometry},
+                          {"primitive_ids", primitive},
+                          {"primitive_uvs", uv},
+                          {"primitive_normals", normal}});
 }
 
 template <class Real>
@@ -166,6 +164,19 @@ py::array_t<Real> distance_as(const TriangleStructure<float>& target, const Floa
     py::gil_scoped_release release;
     closest_points(target, point_arrays<Real>(points), outputs, config);
     return distance;
+}
+
+/// compute_distance and compute_signed_distance: the points' (signed) distances to the nearest
+/// triangle in the points' precision, the arguments checked in the order they are given.
+py::array distances(const RaycastingScene& self, const py::handle& points_object, int nthreads,
+                    int nsamples, bool signed_distance) {
+    const FloatInput points = float_input(points_object, "query_points", 3, "(..., 3)");
+    check_samples(nsamples);
+    const BatchConfig config = batch_config(nthreads);
+    const auto snapshot = self.snapshot();
+    return points.is_float32
+               ? py::array(distance_as<float>(snapshot->view(), points, signed_distance, config))
+               : py::array(distance_as<double>(snapshot->view(), points, signed_distance, config));
 }
 
 py::array create_rays_pinhole(double fov_deg, const Eigen::Vector3d& center,
@@ -306,34 +317,23 @@ triangles: NaN points and INVALID_ID.
 )doc" + points_doc).c_str());
     scene.def(
         "compute_distance",
-        [](const RaycastingScene& self, const py::handle& points_object, int nthreads) {
-            const FloatInput points =
-                float_input(points_object, "query_points", 3, "(..., 3)");
-            const BatchConfig config = batch_config(nthreads);
-            const auto snapshot = self.snapshot();
-            return points.is_float32
-                       ? py::array(distance_as<float>(snapshot->view(), points, false, config))
-                       : py::array(distance_as<double>(snapshot->view(), points, false, config));
+        [](const RaycastingScene& self, const py::handle& points, int nthreads) {
+            return distances(self, points, nthreads, 1, false);
         },
         "query_points"_a, "nthreads"_a = 0,
         ("The unsigned distance from every point to the nearest triangle (the points' "
-         "precision and leading shape; inf with no triangles).\n" + points_doc).c_str());
+         "precision and leading shape; inf with no triangles).\n" +
+         points_doc)
+            .c_str());
     scene.def(
         "compute_signed_distance",
-        [](const RaycastingScene& self, const py::handle& points_object, int nthreads,
-           int nsamples) {
-            const FloatInput points =
-                float_input(points_object, "query_points", 3, "(..., 3)");
-            check_samples(nsamples);
-            const BatchConfig config = batch_config(nthreads);
-            const auto snapshot = self.snapshot();
-            return points.is_float32
-                       ? py::array(distance_as<float>(snapshot->view(), points, true, config))
-                       : py::array(distance_as<double>(snapshot->view(), points, true, config));
+        [](const RaycastingScene& self, const py::handle& points, int nthreads, int nsamples) {
+            return distances(self, points, nthreads, nsamples, true);
         },
         "query_points"_a, "nthreads"_a = 0, "nsamples"_a = 1,
         ("The distance to the nearest triangle, negative inside (inside as compute_occupancy "
-         "decides it): meant for closed meshes.\nnsamples: must be 1.\n" + points_doc)
+         "decides it): meant for closed meshes.\nnsamples: must be 1.\n" +
+         points_doc)
             .c_str());
     scene.def_static("create_rays_pinhole", &create_rays_pinhole, "fov_deg"_a, "center"_a,
                      "eye"_a, "up"_a, "width_px"_a, "height_px"_a, R"doc(

@@ -14,6 +14,7 @@
 #include "csgrt/render/cost_layers.h"
 #include "csgrt/render/exr.h"
 #include "csgrt/render/renderer.h"
+#include "arrays.h"
 #include "scene.h"
 
 namespace csgrt::python {
@@ -128,20 +129,17 @@ py::dict render_scene(const PyScene& self, int width, int height, int spp, int n
         py::gil_scoped_release release;
         write_render_files(path, result.image, metadata, ToneMapping{}, layers);
     }
-    py::dict out;
-    out["color"] = color;
-    out["depth"] = depth;
-    out["normal"] = normal;
-    out["object_id"] = object_id;
-    out["cost"] = cost;
-    out["cost_nodes"] = cost_nodes;
-    out["cost_primitives"] = cost_primitives;
-    out["cost_solves"] = cost_solves;
-    py::dict stats;
-    stats["primary_rays"] = result.stats.primary_rays;
-    stats["shadow_rays"] = result.stats.shadow_rays;
-    stats["seconds"] = result.stats.seconds;
-    out["stats"] = stats;
+    py::dict out = named_results({{"color", color},
+                                  {"depth", depth},
+                                  {"normal", normal},
+                                  {"object_id", object_id},
+                                  {"cost", cost},
+                                  {"cost_nodes", cost_nodes},
+                                  {"cost_primitives", cost_primitives},
+                                  {"cost_solves", cost_solves}});
+    out["stats"] = named_results({{"primary_rays", py::int_(result.stats.primary_rays)},
+                                  {"shadow_rays", py::int_(result.stats.shadow_rays)},
+                                  {"seconds", py::float_(result.stats.seconds)}});
     if (cost_all) out["cost_layers"] = layers_dict(layers);
     return out;
 }
