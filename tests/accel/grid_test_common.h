@@ -200,6 +200,19 @@ AgreementCounts expect_agreement(const Accelerator<Set>& structure, const BruteF
     return expect_agreement({&structure}, brute, rays, all_hits_every);
 }
 
+/// Valid rays with odd numbers, answered as brute force answers them: directions with
+/// denormal and huge components from `outside`, an origin 10^12 away on outside's line along
+/// x, and a direction of components near 1e-150 from `inside`.
+template <class Set>
+void expect_odd_rays_agree(const Accelerator<Set>& structure, const BruteForce<Set>& brute,
+                           const Point3& outside, const Point3& inside) {
+    const std::vector<Ray> odd = {Ray{outside, Vector3(1, 1e-310, -1e-310)},
+                                  Ray{outside, Vector3(1e30, 1e-10, 0)},
+                                  Ray{Point3(-1e12, outside.y(), outside.z()), Vector3(1, 0, 0)},
+                                  Ray{inside, Vector3(1e-150, 2e-150, 3e-150)}};
+    expect_agreement(structure, brute, odd, 1);
+}
+
 /// Answers `rays` from `threads` threads at once (each a strided share, each with its own
 /// scratch) and checks every answer equals the single-threaded one.
 template <class Set>

@@ -126,11 +126,9 @@ TEST(Disk, MatchesALongDoubleSolve) {
         ASSERT_EQ(hit.has_value(), expected) << "ray " << i;
         if (!hit) continue;
         ++hits;
-        // Forward error of the plane solve, as for the plane: <= 6 roundings per term.
-        const long double magnitude = ((c.cwiseAbs() + o.cwiseAbs()).dot(n.cwiseAbs()) +
-                                       std::abs(t) * d.cwiseAbs().dot(n.cwiseAbs())) /
-                                      std::abs(d.dot(n));
-        EXPECT_NEAR(hit->t, double(t), double(gamma(6) * magnitude)) << "ray " << i;
+        // The plane solve's forward error, as for the plane.
+        EXPECT_NEAR(hit->t, double(t), double(test::plane_solve_bound(c, o, d, n, t)))
+            << "ray " << i;
     }
     EXPECT_GT(compared, 49000);
     EXPECT_GT(hits, 10000);

@@ -140,13 +140,8 @@ TEST(Plane, MatchesALongDoubleSolve) {
         const std::optional<Hit> hit = plane.intersect(ray);
         ASSERT_EQ(hit.has_value(), expected >= 0) << "ray " << i;
         if (!hit) continue;
-        // Forward error of ((a - o) . n) / (d . n): each term of both dot products carries at
-        // most 5 roundings (subtraction, product, sums, division) relative to its magnitude.
-        const long double magnitude = ((a.cwiseAbs() + o.cwiseAbs()).dot(n.cwiseAbs()) +
-                                       std::abs(expected) * d.cwiseAbs().dot(n.cwiseAbs())) /
-                                      std::abs(d.dot(n));
         EXPECT_NEAR(hit->t, static_cast<double>(expected),
-                    static_cast<double>(gamma(6) * magnitude))
+                    static_cast<double>(test::plane_solve_bound(a, o, d, n, expected)))
             << "ray " << i;
     }
 }

@@ -21,9 +21,7 @@ namespace {
 Vector3 floor_radiance(Scene scene, const Point3& target) {
     test::set_view(scene, target + Vector3(0.0, 0.5, 2.0), target);
     scene.commit();
-    RenderSettings settings;
-    settings.width = 1;
-    settings.height = 1;
+    RenderSettings settings = test::settings_of_size(1, 1);
     const RenderResult result = render(scene, settings);
     const Pixel& pixel = result.image.at(0, 0);
     return Vector3(pixel.red, pixel.green, pixel.blue);
@@ -172,9 +170,7 @@ TEST(AreaLight, RendersAreTheSameWhateverTheThreads) {
     scene.add_light(SphereLight{Point3(-2, 2, 1), 0.3, Vector3::Constant(20.0), 16});
     test::set_view(scene, Point3(0, 2, 4), Point3(0, 0.3, 0));
     scene.commit();
-    RenderSettings settings;
-    settings.width = 24;
-    settings.height = 16;
+    RenderSettings settings = test::settings_of_size(24, 16);
     settings.tile_size = 4;
     settings.samples_per_pixel = 2;
     settings.threads = 1;

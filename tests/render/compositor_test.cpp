@@ -70,9 +70,7 @@ std::string bytes_of(const fs::path& path) {
 Image rendered_image() {
     Scene scene = test::spheres_on_a_plane();
     scene.commit();
-    RenderSettings settings;
-    settings.width = 24;
-    settings.height = 16;
+    RenderSettings settings = test::settings_of_size(24, 16);
     Image image = render(scene, settings).image;
     image.at(0, 0).object_id = (1u << 24) + 1u;
     return image;
@@ -131,9 +129,7 @@ TEST(Compositor, IdenticalRendersGiveByteIdenticalFiles) {
     const fs::path directory = fresh_directory("compositor_identical");
     Scene scene = test::spheres_on_a_plane();
     scene.commit();
-    RenderSettings settings;
-    settings.width = 32;
-    settings.height = 24;
+    RenderSettings settings = test::settings_of_size(32, 24);
     settings.samples_per_pixel = 4;
     for (const char* name : {"a.exr", "b.exr"}) {
         settings.threads = name[0] == 'a' ? 1 : 2;  // the schedule must not matter either

@@ -161,11 +161,7 @@ Scene one_mesh_scene(const std::string& structure) {
     Scene scene;
     scene.add_object(
         std::make_shared<Mesh>(TriangleMeshData{sphere.vertices, sphere.triangles, {}}, config));
-    Camera camera;
-    camera.position = Point3(0.3, 0.4, 4.0);
-    camera.look_at = Point3(0, 0, 0);
-    camera.vertical_fov_degrees = 40.0;
-    scene.set_camera(camera);
+    test::set_view(scene, Point3(0.3, 0.4, 4.0), Point3(0, 0, 0), 40.0);
     SceneConfig scene_config;
     scene_config.accelerator = "brute";
     scene.commit(scene_config);
@@ -173,9 +169,7 @@ Scene one_mesh_scene(const std::string& structure) {
 }
 
 TEST(Cost, ASceneThatIsOneMeshCostsWhatItsMeshStructureDoes) {
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 12;
+    RenderSettings settings = test::settings_of_size(16, 12);
     std::set<std::uint64_t> totals;
     std::uint64_t brute_total = 0;
     for (const std::string_view name : accelerator_names()) {
@@ -216,9 +210,7 @@ TEST(Cost, ASceneThatIsOneMeshCostsWhatItsMeshStructureDoes) {
 TEST(Cost, SolvesByKindAddUpToTheSolvesAndHitsByLeafKindToTheHits) {
     Scene scene = test::csg_solids();  // a box, spheres and an instanced cylinder in CSG
     scene.commit();
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 12;
+    RenderSettings settings = test::settings_of_size(16, 12);
     const RenderStats stats = render(scene, settings).stats;
     std::uint64_t solves = 0, hits = 0;
     for (const auto& [kind, count] : stats.solves_by_kind) solves += count;
@@ -271,9 +263,7 @@ TEST(CostLayers, EveryStructureOfTheSceneIsRebuiltAndSharedShapesStayShared) {
     EXPECT_GT(structure_build_milliseconds(rebuilt), 0.0);
 
     // The geometry is the same: every pixel's object and depth agree.
-    RenderSettings settings;
-    settings.width = 12;
-    settings.height = 9;
+    RenderSettings settings = test::settings_of_size(12, 9);
     const Image before = render(scene, settings).image;
     const Image after = render(rebuilt, settings).image;
     int hits = 0;
@@ -287,9 +277,7 @@ TEST(CostLayers, EveryStructureOfTheSceneIsRebuiltAndSharedShapesStayShared) {
 
 TEST(CostLayers, EachLayerIsTheCostOfTheSceneBuiltWithItsStructure) {
     const Scene scene = one_mesh_scene("bvh");
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 6;
+    RenderSettings settings = test::settings_of_size(8, 6);
     const std::vector<CostLayer> layers = cost_layers(scene, settings, {"brute", "grid"});
     ASSERT_EQ(layers.size(), 2u);
     EXPECT_EQ(layers[0].structure, "brute");

@@ -52,9 +52,7 @@ TEST(Glass, ABallLensFocusesAtTheLensMakersFocalLength) {
             scene.add_material(Material{"white", Vector3(1, 1, 1)}));
         test::set_orthographic_view(scene, Point3(0, 0, 5), Point3(0, 0, 0), 0.1);
         scene.commit();
-        RenderSettings settings;
-        settings.width = 9;
-        settings.height = 9;
+        RenderSettings settings = test::settings_of_size(9, 9);
         const Image image = render(scene, settings).image;
         int lit = 0, checked = 0;
         for (int y = 0; y < 9; ++y) {

@@ -83,9 +83,7 @@ TEST_P(Golden, MatchesTheStoredImage) {
     SceneConfig config;
     config.accelerator = "brute";  // pinned: the cost channel depends on the structure
     scene.commit(config);
-    RenderSettings settings;
-    settings.width = 64;
-    settings.height = 64;
+    RenderSettings settings = test::settings_of_size(64, 64);
     settings.samples_per_pixel = golden.samples_per_pixel;
     const Image image = render(scene, settings).image;
     const fs::path path = kGoldenDirectory / (golden.name + ".exr");
@@ -134,9 +132,7 @@ TEST(Showcase, EveryObjectIsInFrameAndNoneIsCutByTheEdge) {
     // (the docs' aspect ratio): a pixel is 1/120 of the 38-degree field, finer than any gap.
     Scene scene = load_scene(kScenes / "showcase.json");
     scene.commit();
-    RenderSettings settings;
-    settings.width = 160;
-    settings.height = 120;
+    RenderSettings settings = test::settings_of_size(160, 120);
     settings.max_depth = 0;
     const Image image = render(scene, settings).image;
     std::vector<bool> seen(scene.objects().size(), false);

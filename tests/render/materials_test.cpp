@@ -297,9 +297,7 @@ TEST(CsgMaterials, EachOperandShowsItsOwnAndACutShowsTheSubtractedOne) {
     scene.add_object(make_difference(box, {ball, slot}), green);
     test::set_orthographic_view(scene, Point3(0.5, 0.5, 5), Point3(0.5, 0.5, 0), 1.0);
     scene.commit();
-    RenderSettings settings;
-    settings.width = 10;
-    settings.height = 10;
+    RenderSettings settings = test::settings_of_size(10, 10);
     const Image image = render(scene, settings).image;
     // Pixel (x, y) looks down at (0.05 + 0.1 x, 0.95 - 0.1 y).
     auto colour = [&](int x, int y) {

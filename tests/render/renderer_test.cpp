@@ -53,14 +53,6 @@ long double sphere_root(const TestRay& ray, const Point3& centre, double radius,
     return t >= 0 ? t : -1;
 }
 
-RenderSettings small(int width, int height, int samples = 1) {
-    RenderSettings settings;
-    settings.width = width;
-    settings.height = height;
-    settings.samples_per_pixel = samples;
-    return settings;
-}
-
 struct SphereSpec {
     Point3 centre;
     double radius;
@@ -79,7 +71,7 @@ TEST(Render, CentreDepthIsTheAnalyticDistanceToASphere) {
             scene.set_camera(camera);
             scene.commit();
             // An odd size puts the centre pixel's ray exactly on the line to look_at.
-            const Image image = render(scene, small(63, 41)).image;
+            const Image image = render(scene, test::settings_of_size(63, 41)).image;
             const Pixel& pixel = image.at(31, 20);
             const double expected = (position - centre).norm() - 0.7;
             // Depth is stored as float: within one float rounding (2^-24 relative), doubled.
@@ -109,7 +101,7 @@ TEST(Render, EveryPixelsIdDepthAndNormalMatchAnAnalyticTraceOfTheSpheres) {
         scene.set_camera(camera);
         scene.commit();
         const int width = 80, height = 60;
-        const Image image = render(scene, small(width, height)).image;
+        const Image image = render(scene, test::settings_of_size(width, height)).image;
         int compared = 0, background = 0;
         for (int y = 0; y < height; ++y) {
             for (int x = 0; x < width; ++x) {
@@ -166,7 +158,7 @@ TEST(Render, LambertShadingOfPointAndDirectionalLightsMatchesTheFormula) {
     camera.position = Point3(0, 0, 5);
     scene.set_camera(camera);
     scene.commit();
-    const RenderResult result = render(scene, small(31, 31));
+    const RenderResult result = render(scene, test::settings_of_size(31, 31));
     // Centre pixel: the hit is (0, 0, 1) with normal +z. The point light is at distance^2 22
     // with cosine 3 / sqrt(22); the directional light shines straight at the surface.
     const Vector3 expected =
@@ -191,7 +183,7 @@ TEST(Render, HardShadowOfASphereOnAPlaneIsExactlyWhereTheSphereBlocksTheLight) {
     test::set_view(scene, Point3(0, 4, 6), Point3(0, 0, 0));
     scene.commit();
     const int width = 96, height = 72;
-    const Image image = render(scene, small(width, height)).image;
+    const Image image = render(scene, test::settings_of_size(width, height)).image;
     const double lit = 0.8 / kPi;  // albedo / pi * E * cos 0
     int shadowed = 0, unshadowed = 0;
     for (int y = 0; y < height; ++y) {
@@ -227,7 +219,7 @@ TEST(Render, ASceneWithoutLightsIsLitFromTheEyeAndCastsNoShadowRays) {
     camera.position = Point3(0, 0, 4);
     scene.set_camera(camera);
     scene.commit();
-    const RenderResult result = render(scene, small(21, 21, 4));
+    const RenderResult result = render(scene, test::settings_of_size(21, 21, 4));
     EXPECT_EQ(result.stats.shadow_rays, 0u);
     // The centre pixel's samples leave the camera at most half a pixel diagonal from the axis,
     // alpha <= tan(20 deg) * 2 / 21 * sqrt(2) / 2 = 0.0245 rad; with the camera 3 radii from
@@ -240,7 +232,7 @@ TEST(Render, ASceneWithoutLightsIsLitFromTheEyeAndCastsNoShadowRays) {
     }
     // With one sample, the centre ray is on the axis: exactly the albedo (half-rounded).
     // A copy: the RenderResult is a temporary that dies at the end of this statement.
-    const Pixel centre = render(scene, small(21, 21, 1)).image.at(10, 10);
+    const Pixel centre = render(scene, test::settings_of_size(21, 21, 1)).image.at(10, 10);
     EXPECT_NEAR(centre.red, albedo.x(), albedo.x() * 0x1.0p-10);
     EXPECT_NEAR(centre.green, albedo.y(), albedo.y() * 0x1.0p-10);
     EXPECT_NEAR(centre.blue, albedo.z(), albedo.z() * 0x1.0p-10);
@@ -255,10 +247,10 @@ TEST(Render, CountsPrimaryAndShadowRays) {
     scene.set_camera(camera);
     scene.commit();
     // Every camera ray hits the plane, which faces the light: one shadow ray per colour sample.
-    const RenderResult one = render(scene, small(10, 7, 1));
+    const RenderResult one = render(scene, test::settings_of_size(10, 7, 1));
     EXPECT_EQ(one.stats.primary_rays, 70u);
     EXPECT_EQ(one.stats.shadow_rays, 70u);
-    const RenderResult nine = render(scene, small(10, 7, 9));
+    const RenderResult nine = render(scene, test::settings_of_size(10, 7, 9));
     EXPECT_EQ(nine.stats.primary_rays, 70u * 9 + 70u);  // samples plus the AOV centre ray
     EXPECT_EQ(nine.stats.shadow_rays, 70u * 9);
     EXPECT_GT(nine.stats.seconds, 0.0);
@@ -275,7 +267,7 @@ TEST(Render, StratifiedSamplesEstimateTheCoverageOfAnEdge) {
     camera.orthographic_height = 16.0;
     scene.set_camera(camera);
     scene.commit();
-    const Image image = render(scene, small(16, 16, 16)).image;
+    const Image image = render(scene, test::settings_of_size(16, 16, 16)).image;
     double sum = 0.0;
     for (int y = 0; y < 16; ++y) {
         for (int x = 0; x < 8; ++x) EXPECT_EQ(image.at(x, y).alpha, 0.0f);
@@ -316,7 +308,7 @@ bool same_pixels(const Image& a, const Image& b, bool compare_cost) {
 TEST(Render, OutputDoesNotDependOnThreadsOrTiles) {
     Scene scene = test::spheres_on_a_plane();
     scene.commit();
-    RenderSettings settings = small(53, 37, 4);
+    RenderSettings settings = test::settings_of_size(53, 37, 4);
     settings.threads = 1;
     const RenderResult one = render(scene, settings);
     for (int threads : {2, 3}) {
@@ -338,10 +330,10 @@ TEST(Render, EveryStructureGivesTheSameImages) {
     for (int which = 0; which < 2; ++which) {
         Scene scene = which == 0 ? test::spheres_on_a_plane() : test::sphere_lattice(5);
         scene.commit(structure("brute"));
-        const Image reference = render(scene, small(48, 36, 4)).image;
+        const Image reference = render(scene, test::settings_of_size(48, 36, 4)).image;
         for (std::string_view name : accelerator_names()) {
             scene.commit(structure(name));
-            const Image image = render(scene, small(48, 36, 4)).image;
+            const Image image = render(scene, test::settings_of_size(48, 36, 4)).image;
             // Colour, depth, normal and id pixel-exact: structures return the same hits.
             EXPECT_TRUE(same_pixels(reference, image, false)) << name;
         }
@@ -353,7 +345,7 @@ TEST(Render, CostIsLowerWithAHierarchyThanWithBruteForce) {
     scene.commit(structure("brute"));
     auto total_cost = [&] {
         double sum = 0.0;
-        const Image image = render(scene, small(40, 30)).image;
+        const Image image = render(scene, test::settings_of_size(40, 30)).image;
         for (const Pixel& pixel : image.pixels()) sum += pixel.cost;
         return sum;
     };
@@ -373,7 +365,7 @@ TEST(Render, CostIsLowerWithAHierarchyThanWithBruteForce) {
 TEST(Render, ReportsProgressUpToOne) {
     Scene scene = test::spheres_on_a_plane();
     scene.commit();
-    RenderSettings settings = small(40, 20);
+    RenderSettings settings = test::settings_of_size(40, 20);
     settings.tile_size = 8;  // 5 x 3 tiles
     std::mutex mutex;
     std::vector<double> reports;
@@ -390,19 +382,20 @@ TEST(Render, ReportsProgressUpToOne) {
 
 TEST(Render, RejectsBadSettingsAndUncommittedScenes) {
     Scene scene = test::spheres_on_a_plane();
-    EXPECT_THROW(render(scene, small(8, 8)), InvalidParameter);  // not committed
+    EXPECT_THROW(render(scene, test::settings_of_size(8, 8)), InvalidParameter);  // not committed
     scene.commit();
-    EXPECT_NO_THROW(render(scene, small(1, 1)));
-    EXPECT_THROW(render(scene, small(0, 8)), InvalidParameter);
-    EXPECT_THROW(render(scene, small(8, -1)), InvalidParameter);
-    EXPECT_THROW(render(scene, small(kMaxImageSize + 1, 8)), InvalidParameter);
-    EXPECT_THROW(render(scene, small(8, 8, 0)), InvalidParameter);
-    EXPECT_THROW(render(scene, small(8, 8, kMaxSamplesPerPixel + 1)), InvalidParameter);
-    RenderSettings settings = small(8, 8);
+    EXPECT_NO_THROW(render(scene, test::settings_of_size(1, 1)));
+    EXPECT_THROW(render(scene, test::settings_of_size(0, 8)), InvalidParameter);
+    EXPECT_THROW(render(scene, test::settings_of_size(8, -1)), InvalidParameter);
+    EXPECT_THROW(render(scene, test::settings_of_size(kMaxImageSize + 1, 8)), InvalidParameter);
+    EXPECT_THROW(render(scene, test::settings_of_size(8, 8, 0)), InvalidParameter);
+    EXPECT_THROW(render(scene, test::settings_of_size(8, 8, kMaxSamplesPerPixel + 1)),
+                 InvalidParameter);
+    RenderSettings settings = test::settings_of_size(8, 8);
     settings.threads = -2;
     EXPECT_THROW(render(scene, settings), InvalidParameter);
     try {
-        render(scene, small(8, 20000));
+        render(scene, test::settings_of_size(8, 20000));
         FAIL() << "no exception";
     } catch (const InvalidParameter& error) {
         EXPECT_NE(std::string(error.what()).find("height"), std::string::npos) << error.what();

@@ -6,15 +6,28 @@
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/scene.h"
+#include "csgrt/render/renderer.h"
 
 namespace csgrt::test {
 
-/// Gives `scene` the default pinhole camera at `position` looking at `look_at`.
-inline void set_view(Scene& scene, const Point3& position, const Point3& look_at) {
+/// Gives `scene` a pinhole camera at `position` looking at `look_at` (the default field of
+/// view unless one is given, in degrees, vertically).
+inline void set_view(Scene& scene, const Point3& position, const Point3& look_at,
+                     double vertical_fov_degrees = Camera{}.vertical_fov_degrees) {
     Camera camera;
     camera.position = position;
     camera.look_at = look_at;
+    camera.vertical_fov_degrees = vertical_fov_degrees;
     scene.set_camera(camera);
+}
+
+/// Default render settings for an image of width x height pixels, `samples` a pixel.
+inline RenderSettings settings_of_size(int width, int height, int samples = 1) {
+    RenderSettings settings;
+    settings.width = width;
+    settings.height = height;
+    settings.samples_per_pixel = samples;
+    return settings;
 }
 
 /// Gives `scene` an orthographic camera at `position` looking at `look_at`, whose view is
@@ -42,11 +55,7 @@ inline Scene spheres_on_a_plane() {
     scene.add_object(std::make_shared<Sphere>(Point3(1.4, 0.4, 0.7), 0.4), blue, "right");
     scene.add_light(PointLight{Point3(-3, 6, 4), Vector3(150, 150, 150)});
     scene.add_light(DirectionalLight{Vector3(0.4, -1.0, -0.3), Vector3(1.5, 1.4, 1.2)});
-    Camera camera;
-    camera.position = Point3(0.5, 2.5, 6.0);
-    camera.look_at = Point3(0.0, 0.6, 0.0);
-    camera.vertical_fov_degrees = 40.0;
-    scene.set_camera(camera);
+    test::set_view(scene, Point3(0.5, 2.5, 6.0), Point3(0.0, 0.6, 0.0), 40.0);
     return scene;
 }
 

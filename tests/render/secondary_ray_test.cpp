@@ -25,11 +25,16 @@
 #include "csgrt/mesh/mesh.h"
 #include "csgrt/render/renderer.h"
 #include "csgrt/render/shadow_offset.h"
+#include "render/scenes.h"
 #include "support/meshes.h"
+#include "support/placed_mesh.h"
 #include "support/random.h"
 
 namespace csgrt {
 namespace {
+
+using test::direction_around;
+using test::mesh_at;
 
 constexpr std::array<double, 4> kTranslations = {0.0, 1e2, 1e4, 1e6};
 
@@ -44,15 +49,6 @@ struct Subject {
     /// again. Otherwise only a re-hit of the same primitive next to the start is forbidden.
     bool convex = false;
 };
-
-std::shared_ptr<const Shape> mesh_at(const test::TestMesh& mesh, const Transform& placement,
-                                     bool double_precision) {
-    TriangleMeshData data{mesh.vertices, mesh.triangles, {}};
-    for (Eigen::Vector3d& v : data.vertices) v = placement.apply_point(v);
-    MeshConfig config;
-    config.double_precision = double_precision;
-    return std::make_shared<Mesh>(std::move(data), config);
-}
 
 /// Every kind of leaf, instances with rotation, non-uniform scale and shear, CSG, and meshes
 /// (float and double, placed in world space and under an instance), around `place` with size
@@ -109,16 +105,6 @@ std::vector<Subject> subjects(const Point3& place, double size) {
              true});
     }
     return list;
-}
-
-/// A direction whose cosine with `axis` (unit) lies in [minimum_cosine, 1].
-Vector3 direction_around(test::Random& random, const Vector3& axis, double minimum_cosine) {
-    for (;;) {
-        const Vector3 d = random.unit_vector();
-        const double cosine = d.dot(axis);
-        if (cosine >= minimum_cosine) return d * random.uniform(0.25, 4.0);
-        if (-cosine >= minimum_cosine) return -d * random.uniform(0.25, 4.0);
-    }
 }
 
 TEST(SecondaryRays, NeverRehitTheSurfaceTheyLeaveWhereverTheSceneIs) {
@@ -230,19 +216,13 @@ Scene thin_gaps(const Vector3& shift) {
         0, "block 0.002 above");
     // Low, so that shadows reach out from under their casters where the camera sees them.
     scene.add_light(PointLight{shift + Vector3(5.0, 1.5, 2.0), Vector3(100, 100, 100)});
-    Camera camera;
-    camera.position = shift + Vector3(0.0, 3.0, 6.0);
-    camera.look_at = shift + Vector3(0.0, 0.0, 0.0);
-    camera.vertical_fov_degrees = 45.0;
-    scene.set_camera(camera);
+    test::set_view(scene, shift + Vector3(0.0, 3.0, 6.0), shift + Vector3(0.0, 0.0, 0.0), 45.0);
     scene.commit();
     return scene;
 }
 
 TEST(SecondaryRays, AMovedSceneShadowsTheSamePixelsAndKeepsItsThinGaps) {
-    RenderSettings settings;
-    settings.width = 64;
-    settings.height = 48;
+    RenderSettings settings = test::settings_of_size(64, 48);
     settings.threads = 1;
     const Scene at_origin = thin_gaps(Vector3::Zero());
     const RenderResult reference = render(at_origin, settings);
@@ -502,9 +482,7 @@ std::vector<Cavity> cavities() {
 }
 
 TEST(SecondaryRays, GrazingLightInConcaveCavitiesMatchesALongDoubleReference) {
-    RenderSettings settings;
-    settings.width = 48;
-    settings.height = 48;
+    RenderSettings settings = test::settings_of_size(48, 48);
     settings.threads = 1;
     std::printf(
         "\n  | cavity | translation | pixels | lit | dark | ambiguous (within 1e-9) |"
@@ -517,11 +495,7 @@ TEST(SecondaryRays, GrazingLightInConcaveCavitiesMatchesALongDoubleReference) {
             Scene scene;
             scene.add_object(cavity.shape(shift), 0, cavity.name);
             scene.add_light(PointLight{shift + cavity.light, Vector3(10, 10, 10)});
-            Camera camera;
-            camera.position = shift + cavity.eye;
-            camera.look_at = shift + cavity.look_at;
-            camera.vertical_fov_degrees = cavity.fov_degrees;
-            scene.set_camera(camera);
+            test::set_view(scene, shift + cavity.eye, shift + cavity.look_at, cavity.fov_degrees);
             scene.commit();
             const RenderResult result = render(scene, settings);
             const CameraFilm film(scene.camera(), 1.0);

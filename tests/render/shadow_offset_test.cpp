@@ -15,17 +15,9 @@
 namespace csgrt {
 namespace {
 
-constexpr std::array<double, 6> kScales = {1e-4, 1e-2, 1.0, 1e2, 1e4, 1e6};
+using test::direction_around;
 
-/// A direction whose cosine with `axis` (unit) is at least `minimum_cosine`.
-Vector3 direction_around(test::Random& random, const Vector3& axis, double minimum_cosine) {
-    for (;;) {
-        const Vector3 d = random.unit_vector();
-        const double cosine = d.dot(axis);
-        if (cosine >= minimum_cosine) return d * random.uniform(0.25, 4.0);
-        if (-cosine >= minimum_cosine) return -d * random.uniform(0.25, 4.0);
-    }
-}
+constexpr std::array<double, 6> kScales = {1e-4, 1e-2, 1.0, 1e2, 1e4, 1e6};
 
 /// The largest coordinate magnitude of a box and a point, as the renderer computes it.
 double magnitude_of(const Aabb& box, const Point3& camera) {

@@ -29,6 +29,35 @@
 namespace csgrt {
 namespace {
 
+/// The answers of `shape` for `ray` are well formed: occluded agrees with intersect; a hit
+/// lies in the interval at a finite point with unit normals (1e-9 leaves room for a few
+/// roundings of the normalisation, far below any real defect) and uv in [0, 1]^2; a solid's
+/// spans are ordered and disjoint, and its membership test answers. Returns whether it hit.
+bool expect_sane_answers(const Shape& shape, const Ray& ray, const std::string& where) {
+    const std::optional<Hit> hit = shape.intersect(ray);
+    EXPECT_EQ(shape.occluded(ray), hit.has_value()) << where;
+    if (hit) {
+        EXPECT_TRUE(ray.in_range(hit->t)) << where;
+        EXPECT_TRUE(is_finite(hit->point)) << where;
+        EXPECT_NEAR(hit->geometric_normal.norm(), 1.0, 1e-9) << where;
+        EXPECT_NEAR(hit->shading_normal.norm(), 1.0, 1e-9) << where;
+        EXPECT_TRUE(hit->uv.x() >= 0.0 && hit->uv.x() <= 1.0 && hit->uv.y() >= 0.0 &&
+                    hit->uv.y() <= 1.0)
+            << where;
+    }
+    if (shape.is_solid()) {
+        const SpanList spans = shape.spans(ray);
+        for (std::size_t k = 0; k < spans.size(); ++k) {
+            EXPECT_LE(spans[k].enter.t, spans[k].exit.t) << where;
+            if (k > 0) {
+                EXPECT_LE(spans[k - 1].exit.t, spans[k].enter.t) << where;
+            }
+        }
+        (void)shape.contains(ray.origin);
+    }
+    return hit.has_value();
+}
+
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
 using Make = std::function<std::shared_ptr<const Shape>()>;
@@ -268,31 +297,7 @@ TEST(DegenerateGeometry, AcceptedShapesAnswerEveryQueryWellFormed) {
         int hits = 0;
         for (int i = 0; i < 2000; ++i) {
             const Ray ray = random.ray_between(from, accepted.region);
-            const std::optional<Hit> hit = shape.intersect(ray);
-            const std::string where = accepted.name + ", ray " + std::to_string(i);
-            EXPECT_EQ(shape.occluded(ray), hit.has_value()) << where;
-            if (hit) {
-                ++hits;
-                EXPECT_TRUE(ray.in_range(hit->t)) << where;
-                EXPECT_TRUE(is_finite(hit->point)) << where;
-                // A unit normal in double: 1e-9 leaves room for a few roundings of the
-                // normalisation, far below any real defect.
-                EXPECT_NEAR(hit->geometric_normal.norm(), 1.0, 1e-9) << where;
-                EXPECT_NEAR(hit->shading_normal.norm(), 1.0, 1e-9) << where;
-                EXPECT_TRUE(hit->uv.x() >= 0.0 && hit->uv.x() <= 1.0 && hit->uv.y() >= 0.0 &&
-                            hit->uv.y() <= 1.0)
-                    << where;
-            }
-            if (shape.is_solid()) {
-                const SpanList spans = shape.spans(ray);
-                for (std::size_t k = 0; k < spans.size(); ++k) {
-                    EXPECT_LE(spans[k].enter.t, spans[k].exit.t) << where;
-                    if (k > 0) {
-                        EXPECT_LE(spans[k - 1].exit.t, spans[k].enter.t) << where;
-                    }
-                }
-                (void)shape.contains(ray.origin);
-            }
+            hits += expect_sane_answers(shape, ray, accepted.name + ", ray " + std::to_string(i));
             queries += 3;
         }
         if (accepted.never_hit) {
@@ -344,29 +349,9 @@ TEST(DegenerateGeometry, EveryRegisteredKindAtExtremeSizesAnswersWellFormed) {
             const Aabb from = test::enlarged(region, 2.0);
             for (int i = 0; i < 300; ++i) {
                 const Ray ray = random.ray_between(from, region);
-                const std::optional<Hit> hit = shape->intersect(ray);
-                const std::string where =
-                    kind.name + " size " + std::to_string(size) + ", ray " + std::to_string(i);
-                EXPECT_EQ(shape->occluded(ray), hit.has_value()) << where;
-                if (hit) {
-                    ++hits;
-                    EXPECT_TRUE(ray.in_range(hit->t)) << where;
-                    EXPECT_TRUE(is_finite(hit->point)) << where;
-                    EXPECT_NEAR(hit->geometric_normal.norm(), 1.0, 1e-9) << where;
-                    EXPECT_NEAR(hit->shading_normal.norm(), 1.0, 1e-9) << where;
-                    EXPECT_TRUE(hit->uv.x() >= 0.0 && hit->uv.x() <= 1.0 && hit->uv.y() >= 0.0 &&
-                                hit->uv.y() <= 1.0)
-                        << where;
-                }
-                if (shape->is_solid()) {
-                    const SpanList spans = shape->spans(ray);
-                    for (std::size_t k = 0; k < spans.size(); ++k) {
-                        EXPECT_LE(spans[k].enter.t, spans[k].exit.t) << where;
-                        if (k > 0) {
-                            EXPECT_LE(spans[k - 1].exit.t, spans[k].enter.t) << where;
-                        }
-                    }
-                }
+                hits += expect_sane_answers(
+                    *shape, ray,
+                    kind.name + " size " + std::to_string(size) + ", ray " + std::to_string(i));
                 queries += 3;
             }
         }

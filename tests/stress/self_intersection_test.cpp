@@ -16,17 +16,20 @@
 #include <string>
 #include <vector>
 
-#include "csgrt/mesh/mesh.h"
 #include "csgrt/core/shapes.h"
 #include "csgrt/csg/boolean.h"
+#include "csgrt/mesh/mesh.h"
 #include "csgrt/render/shadow_offset.h"
 #include "stress/stress_config.h"
 #include "stress/summary.h"
 #include "support/meshes.h"
+#include "support/placed_mesh.h"
 #include "support/random.h"
 
 namespace csgrt {
 namespace {
+
+using test::mesh_at;
 
 struct Subject {
     std::string name;
@@ -37,15 +40,6 @@ struct Subject {
     bool convex = false;
     double minimum_chord = 0.0;
 };
-
-std::shared_ptr<const Shape> mesh_at(const test::TestMesh& mesh, const Transform& placement,
-                                     bool double_precision) {
-    TriangleMeshData data{mesh.vertices, mesh.triangles, {}};
-    for (Eigen::Vector3d& v : data.vertices) v = placement.apply_point(v);
-    MeshConfig config;
-    config.double_precision = double_precision;
-    return std::make_shared<Mesh>(std::move(data), config);
-}
 
 std::vector<Subject> subjects(double scale) {
     const Vector3 place = scale * Vector3(3.0, -2.0, 5.0);

@@ -7,10 +7,24 @@
 #include <optional>
 #include <vector>
 
+#include "csgrt/core/math.h"
 #include "csgrt/core/ray.h"
 #include "csgrt/core/shape.h"
 
 namespace csgrt::test {
+
+/// The forward error bound of a flat shape's plane solve t = ((a - o) . n) / (d . n) (anchor a,
+/// unit normal n, ray o + t d, all exact in long double) at the true `t`: each term of both dot
+/// products carries at most 5 roundings (subtraction, product, sums, division) relative to its
+/// magnitude, so gamma(6) of the terms' magnitudes over |d . n| bounds it.
+template <class Vector>
+long double plane_solve_bound(const Vector& a, const Vector& o, const Vector& d, const Vector& n,
+                              long double t) {
+    const long double magnitude = ((a.cwiseAbs() + o.cwiseAbs()).dot(n.cwiseAbs()) +
+                                   std::abs(t) * d.cwiseAbs().dot(n.cwiseAbs())) /
+                                  std::abs(d.dot(n));
+    return gamma(6) * magnitude;
+}
 
 /// Invalid versions of the valid ray `valid`: each origin and each direction component made NaN,
 /// +inf and -inf in turn, a zero direction, a NaN t_min, a NaN t_max, and t_min 5 above t_max

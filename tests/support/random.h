@@ -61,6 +61,17 @@ private:
     std::mt19937_64 engine_;
 };
 
+/// A direction whose cosine with `axis` (unit) is at least `minimum_cosine`, or its opposite
+/// when that one is, of random length in [0.25, 4].
+inline Vector3 direction_around(Random& random, const Vector3& axis, double minimum_cosine) {
+    for (;;) {
+        const Vector3 d = random.unit_vector();
+        const double cosine = d.dot(axis);
+        if (cosine >= minimum_cosine) return d * random.uniform(0.25, 4.0);
+        if (-cosine >= minimum_cosine) return -d * random.uniform(0.25, 4.0);
+    }
+}
+
 /// `box` grown by `factor` times its diagonal on every side.
 inline Aabb enlarged(const Aabb& box, double factor) {
     const Vector3 margin = box.diagonal() * factor;
