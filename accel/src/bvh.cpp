@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,7 +24,6 @@ namespace csgrt {
 
 namespace {
 
-using detail::kBlockLanes;
 using detail::kFloatInfinity;
 using detail::round_down;
 using detail::round_up;
@@ -90,9 +90,13 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     config_ = config;
     constexpr bool kBlockSet = detail::kBlockLeaves<Set>;
     const bool blocks = kBlockSet && config.triangle_blocks;
-    use_avx2_ = false;
+    use_avx2_ = use_avx512_ = false;
 #if CSGRT_BVH_AVX2
-    use_avx2_ = config.width == 8 && config.avx2 && __builtin_cpu_supports("avx2");
+    use_avx2_ = config.width == 8 && config.avx2 && __builtin_cpu_supports("avx2") &&
+                __builtin_cpu_supports("fma");
+    use_avx512_ = use_avx2_ && __builtin_cpu_supports("avx512f") &&
+                  __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
+                  __builtin_cpu_supports("avx512dq");
 #endif
 
     // Left uninitialised here (AlignedAllocator default-initialises) and written in parallel
@@ -119,16 +123,16 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     }
 
     detail::BinaryBvh tree =
-        detail::build_binary_bvh(primitives, config, blocks ? int(kBlockLanes) : 1);
+        detail::build_binary_bvh(primitives, config, blocks ? int(kBvhLeafLaneGroup) : 1);
     primitives = {};
 
-    // Leaves name their contents: blocks of four triangles copied in leaf order, or entries
-    // of the index array (a one-primitive leaf names its primitive itself). Leaves cover the
-    // index array in order, so blocks are handed out in that order too.
+    // Leaves name their contents: their triangles copied in leaf order, or entries of the
+    // index array (a one-primitive leaf names its primitive itself). Leaves cover the index
+    // array in order, so lanes are handed out in that order too.
     indices_.clear();
-    blocks_.clear();
+    leaf_triangles_ = {};
     if constexpr (kBlockSet) {
-        if (blocks) fill_blocks(set, tree, config.parallel);
+        if (blocks) fill_leaf_triangles(set, tree, config.parallel);
     }
     if (!blocks) {
         for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
@@ -156,26 +160,28 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     // uses, and the pages it never writes are never mapped.
     stats_.bytes = binary_nodes_.capacity() * sizeof(BvhNode) + nodes_4_.size() * sizeof(Bvh4Node) +
                    nodes_8_.size() * sizeof(Bvh8Node) +
-                   indices_.capacity() * sizeof(std::uint32_t) +
-                   blocks_.capacity() * sizeof(BvhTriangleBlock);
+                   indices_.capacity() * sizeof(std::uint32_t) + leaf_triangles_.bytes();
     stats_.nodes = nodes_4_.size() + nodes_8_.size() + binary_nodes_.size();
     stats_.primitives = stats_.references = set.size();
     char details[240];
-    std::snprintf(details, sizeof details,
-                  "width %d, depth %d, %zu leaves (%.2f primitives each), %zu blocks, SAH cost "
-                  "%.2f, %d bins, %.1f bytes per primitive%s",
-                  config.width, tree.depth, tree.leaves,
-                  tree.leaves ? double(set.size()) / double(tree.leaves) : 0.0, blocks_.size(),
-                  tree.sah_cost, config.bins,
-                  set.size() ? double(stats_.bytes) / double(set.size()) : 0.0,
-                  use_avx2_ ? ", AVX2" : "");
+    std::snprintf(
+        details, sizeof details,
+        "width %d, depth %d, %zu leaves (%.2f primitives each), %zu lane groups, SAH cost "
+        "%.2f, %d bins, %.1f bytes per primitive%s",
+        config.width, tree.depth, tree.leaves,
+        tree.leaves ? double(set.size()) / double(tree.leaves) : 0.0,
+        leaf_triangles_.lanes.size() / (10 * kBvhLeafLaneGroup), tree.sah_cost, config.bins,
+        set.size() ? double(stats_.bytes) / double(set.size()) : 0.0,
+        use_avx512_ ? ", AVX2 with AVX-512"
+        : use_avx2_ ? ", AVX2"
+                    : "");
     stats_.details = details;
     stats_.build_milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 template <class Set>
-void Bvh<Set>::fill_blocks(const Set& set, detail::BinaryBvh& tree, bool parallel) {
+void Bvh<Set>::fill_leaf_triangles(const Set& set, detail::BinaryBvh& tree, bool parallel) {
     if (tree.nodes.empty()) return;
     // The leaves in index order: depth first, left child first.
     std::vector<std::uint32_t> leaves, pending{0};
@@ -191,34 +197,34 @@ void Bvh<Set>::fill_blocks(const Set& set, detail::BinaryBvh& tree, bool paralle
             pending.push_back(node.offset);
         }
     }
-    std::vector<std::uint32_t> first_block(leaves.size() + 1, 0);
+    constexpr std::uint32_t kGroup = kBvhLeafLaneGroup;
+    std::vector<std::uint32_t> first_group(leaves.size() + 1, 0);
     for (std::size_t k = 0; k < leaves.size(); ++k) {
-        first_block[k + 1] =
-            first_block[k] + (tree.nodes[leaves[k]].count + kBlockLanes - 1) / kBlockLanes;
+        first_group[k + 1] = first_group[k] + (tree.nodes[leaves[k]].count + kGroup - 1) / kGroup;
     }
-    // Every lane of every block is written below: lanes past a leaf's count get zeros and
+    // Every lane of every leaf is written below: lanes past a leaf's count get zeros and
     // kNoIndex. The storage is left uninitialised until then.
-    blocks_.resize(first_block.back());
+    leaf_triangles_.lanes.resize(std::size_t{10} * kGroup * first_group.back());
     auto fill = [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t k = range.begin(); k != range.end(); ++k) {
             BvhNode& node = tree.nodes[leaves[k]];
-            for (std::uint32_t slot = 0;
-                 slot != (first_block[k + 1] - first_block[k]) * kBlockLanes; ++slot) {
-                BvhTriangleBlock& block = blocks_[first_block[k] + slot / kBlockLanes];
-                const std::uint32_t lane = slot % kBlockLanes;
-                const bool used = slot < node.count;
-                const std::uint32_t primitive = used ? tree.indices[node.offset + slot] : kNoIndex;
-                block.primitive[lane] = primitive;
+            const std::uint32_t lanes = (first_group[k + 1] - first_group[k]) * kGroup;
+            for (std::uint32_t lane = 0; lane != lanes; ++lane) {
+                const auto at = BvhLeafTriangles::place(first_group[k], node.count, lane);
+                const bool used = lane < node.count;
+                const std::uint32_t primitive = used ? tree.indices[node.offset + lane] : kNoIndex;
+                float* group = leaf_triangles_.lanes.data() + at.group;
+                group[9 * at.width + at.lane] = std::bit_cast<float>(primitive);
                 if constexpr (detail::kBlockLeaves<Set>) {
                     for (int corner = 0; corner < 3; ++corner) {
                         for (int axis = 0; axis < 3; ++axis) {
-                            block.corners[corner][axis][lane] =
+                            group[std::size_t(3 * corner + axis) * at.width + at.lane] =
                                 used ? set.corner(primitive, corner)[axis] : 0.0f;
                         }
                     }
                 }
             }
-            node.offset = first_block[k];
+            node.offset = first_group[k];
         }
     };
     const tbb::blocked_range<std::size_t> all(0, leaves.size(), 1024);

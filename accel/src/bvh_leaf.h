@@ -1,9 +1,11 @@
 #pragma once
 
-// The BVH's leaves of TriangleSet<float>: blocks of four triangles tested with the triangle
-// test's own float operations, four or eight lanes at a time, and the ray-parallel test of a
+// The BVH's leaves of TriangleSet<float>: lanes of triangles tested with the triangle test's
+// own float operations, four or eight lanes at a time, and the ray-parallel test of a
 // packet. Private to accel/src/bvh*.
 
+#include <cstddef>
+#include <cstdint>
 #include <type_traits>
 
 #include "bvh_ray.h"
@@ -15,7 +17,7 @@ namespace csgrt::detail {
 template <class Set>
 inline constexpr bool kBlockLeaves = std::is_same_v<Set, TriangleSet<float>>;
 
-/// Four triangles of a block sheared into the frame of the ray, lane by lane, with their edge
+/// Four lanes of a leaf sheared into the frame of the ray, lane by lane, with their edge
 /// functions.
 struct ShearedBlock {
     Float4 x[3], y[3], z[3];
@@ -83,15 +85,26 @@ struct BlockHits {
     }
 };
 
-/// The first half of TriangleSet<float>'s test on the four triangles of a block at once: the
-/// same float operations as TriangleSet::shear and the edge functions of hit_sheared, lane by
-/// lane, so the values are the scalar test's bits. A lane whose three edge functions are
-/// non-zero and of mixed signs is a miss for the scalar test too (it only recomputes exact
-/// zeros).
+/// Floats a lane takes in BvhLeafTriangles: nine corner coordinates and the triangle index.
+inline constexpr std::size_t kLaneFloats = 10;
+
+/// The triangle test's axis a (0, 1, 2: x, y, z) when z is kAxisZ: the axes follow cyclically,
+/// as TriangleSet::prepare permutes them. The leaf tests are compiled for each kAxisZ, so that
+/// the rows they read lie at constant offsets.
+template <int kAxisZ>
+constexpr std::ptrdiff_t test_axis(int a) {
+    return (kAxisZ + 1 + a) % 3;
+}
+
+/// The first half of TriangleSet<float>'s test on four lanes of a leaf at once: the same float
+/// operations as TriangleSet::shear and the edge functions of hit_sheared, lane by lane, so the
+/// values are the scalar test's bits. A lane whose three edge functions are non-zero and of
+/// mixed signs is a miss for the scalar test too (it only recomputes exact zeros).
 struct BlockRay {
     /// The origin's and the shear's components, on the permuted axes (x, y, z of the test).
     Float4 origin[3], shear_x, shear_y;
-    int axis[3];
+    /// The test's axes x, y, z.
+    std::ptrdiff_t axis[3];
 
     explicit BlockRay(const TriangleSet<float>::PreparedRay& ray)
         : shear_x(Float4::broadcast(ray.shear_x)), shear_y(Float4::broadcast(ray.shear_y)) {
@@ -101,16 +114,19 @@ struct BlockRay {
         for (int a = 0; a < 3; ++a) origin[a] = Float4::broadcast(ray.origin[axis[a]]);
     }
 
-    /// The lanes that may hit (bit l for lane l), the block sheared, and in `zeros` the lanes
+    /// The four lanes from `lanes` of a group of kWidth lanes (BvhLeafTriangles; 16-byte
+    /// aligned) that may hit (bit l for lane l), the lanes sheared, and in `zeros` the lanes
     /// with an edge function that is exactly zero (left to TriangleSet::hit_sheared, which
     /// recomputes those in double). Every other candidate lane is a hit whose t and
     /// barycentrics BlockHits gives.
-    unsigned candidates(const BvhTriangleBlock& block, ShearedBlock& sheared,
-                        unsigned& zeros) const {
+    /// kAxisZ is axis[2] (the rows' offsets are then constants).
+    template <int kAxisZ, std::ptrdiff_t kWidth>
+    unsigned candidates(const float* lanes, ShearedBlock& sheared, unsigned& zeros) const {
         for (int k = 0; k < 3; ++k) {
-            const Float4 px = Float4::load_aligned(block.corners[k][axis[0]]) - origin[0];
-            const Float4 py = Float4::load_aligned(block.corners[k][axis[1]]) - origin[1];
-            const Float4 pz = Float4::load_aligned(block.corners[k][axis[2]]) - origin[2];
+            const float* row = lanes + 3 * k * kWidth;
+            const Float4 px = Float4::load_aligned(row + test_axis<kAxisZ>(0) * kWidth) - origin[0];
+            const Float4 py = Float4::load_aligned(row + test_axis<kAxisZ>(1) * kWidth) - origin[1];
+            const Float4 pz = Float4::load_aligned(row + test_axis<kAxisZ>(2) * kWidth) - origin[2];
             sheared.x[k] = px - shear_x * pz;
             sheared.y[k] = py - shear_y * pz;
             sheared.z[k] = pz;
@@ -141,9 +157,9 @@ struct Avx2ShearedLanes {
     unsigned zeros;
 
     /// corners[k][a]: corner k on the test's axis a (x, y, z), lane by lane.
-    [[gnu::target("avx2")]] Avx2ShearedLanes(const __m256 (&corners)[3][3],
-                                             const __m256 (&origin)[3], __m256 shear_x,
-                                             __m256 shear_y) {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] Avx2ShearedLanes(const __m256 (&corners)[3][3],
+                                                            const __m256 (&origin)[3],
+                                                            __m256 shear_x, __m256 shear_y) {
         for (int k = 0; k < 3; ++k) {
             const __m256 px = _mm256_sub_ps(corners[k][0], origin[0]);
             const __m256 py = _mm256_sub_ps(corners[k][1], origin[1]);
@@ -161,9 +177,26 @@ struct Avx2ShearedLanes {
             _mm256_cmp_ps(w, zero, _CMP_EQ_OQ))));
     }
 
+    /// Lanes 4 half .. 4 half + 3 as BlockRay::candidates leaves them in its ShearedBlock.
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] ShearedBlock half(int half) const {
+        ShearedBlock block;
+        for (int k = 0; k < 3; ++k) {
+            block.x[k] = part(x[k], half);
+            block.y[k] = part(y[k], half);
+            block.z[k] = part(z[k], half);
+        }
+        block.u = part(u, half);
+        block.v = part(v, half);
+        block.w = part(w, half);
+        return block;
+    }
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] static Float4 part(__m256 lanes, int half) {
+        return {half == 0 ? _mm256_castps256_ps128(lanes) : _mm256_extractf128_ps(lanes, 1)};
+    }
+
     /// The lanes that may hit: as BlockRay::candidates, a lane is dropped only when its edge
     /// functions are non-zero and of mixed signs (read off their sign bits).
-    [[gnu::target("avx2")]] unsigned candidates() const {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] unsigned candidates() const {
         const unsigned some_negative =
             static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(u, v), w)));
         const unsigned all_negative =
@@ -174,14 +207,14 @@ struct Avx2ShearedLanes {
 #endif
 
 #if CSGRT_BVH_AVX2
-/// BlockRay::candidates on two consecutive blocks at once, lanes 0-3 the first and 4-7 the
-/// second, in 8-lane AVX2 steps: the same operations lane by lane (no fused multiply-add), so
-/// the same bits. Most leaves hold five to eight triangles, two blocks.
+/// BlockRay::candidates on a group of eight lanes at once, in 8-lane AVX2 steps: the same
+/// operations lane by lane (no fused multiply-add), so the same bits. Most leaves hold five to
+/// eight triangles, one such group.
 struct alignas(32) Avx2BlockRay {
     __m256 origin[3], shear_x, shear_y;
-    int axis[3];
+    std::ptrdiff_t axis[3];
 
-    [[gnu::target("avx2")]] explicit Avx2BlockRay(const BlockRay& ray) {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] explicit Avx2BlockRay(const BlockRay& ray) {
         for (int a = 0; a < 3; ++a) {
             origin[a] = _mm256_set_m128(ray.origin[a].v, ray.origin[a].v);
             axis[a] = ray.axis[a];
@@ -190,40 +223,16 @@ struct alignas(32) Avx2BlockRay {
         shear_y = _mm256_set_m128(ray.shear_y.v, ray.shear_y.v);
     }
 
-    // (Lambdas would not inherit the target attribute: these are functions.)
-    [[gnu::target("avx2")]] static __m256 load(const BvhTriangleBlock& first,
-                                               const BvhTriangleBlock& second, int k, int a) {
-        return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(first.corners[k][a])),
-                                    _mm_load_ps(second.corners[k][a]), 1);
-    }
-    [[gnu::target("avx2")]] static void split(__m256 lanes, Float4& low, Float4& high) {
-        low.v = _mm256_castps256_ps128(lanes);
-        high.v = _mm256_extractf128_ps(lanes, 1);
-    }
-
-    /// As BlockRay::candidates, bits 0-3 for `first` and 4-7 for `second`; `sheared` is
-    /// written only when some lane is a candidate.
-    [[gnu::target("avx2")]] unsigned candidates(const BvhTriangleBlock& first,
-                                                const BvhTriangleBlock& second,
-                                                ShearedBlock (&sheared)[2], unsigned& zeros) const {
+    /// The group of eight lanes at `lanes` (32-byte aligned) sheared, with its edge functions:
+    /// its candidates() are BlockRay::candidates' of its two halves (bits 0-3 and 4-7).
+    template <int kAxisZ>
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] Avx2ShearedLanes shear(const float* lanes) const {
         __m256 corners[3][3];
         for (int k = 0; k < 3; ++k) {
-            for (int a = 0; a < 3; ++a) corners[k][a] = load(first, second, k, axis[a]);
+            for (int a = 0; a < 3; ++a)
+                corners[k][a] = _mm256_load_ps(lanes + 24 * k + 8 * test_axis<kAxisZ>(a));
         }
-        const Avx2ShearedLanes lanes(corners, origin, shear_x, shear_y);
-        zeros = lanes.zeros;
-        const unsigned result = lanes.candidates();
-        if (result != 0) {
-            for (int k = 0; k < 3; ++k) {
-                split(lanes.x[k], sheared[0].x[k], sheared[1].x[k]);
-                split(lanes.y[k], sheared[0].y[k], sheared[1].y[k]);
-                split(lanes.z[k], sheared[0].z[k], sheared[1].z[k]);
-            }
-            split(lanes.u, sheared[0].u, sheared[1].u);
-            split(lanes.v, sheared[0].v, sheared[1].v);
-            split(lanes.w, sheared[0].w, sheared[1].w);
-        }
-        return result;
+        return Avx2ShearedLanes(corners, origin, shear_x, shear_y);
     }
 };
 #endif
@@ -238,11 +247,11 @@ struct alignas(32) Avx2BlockRay {
 /// with TriangleSet::hit_sheared on their own values.
 struct alignas(32) PacketTriangleRays {
     __m256 origin[3], shear_x, shear_y;
-    int axis[3];
+    std::ptrdiff_t axis[3];
 
     /// Whether the open rays' prepared rays share their axes; if so, sets the lanes up.
-    [[gnu::target("avx2")]] bool accepts(const TriangleSet<float>::PreparedRay* prepared,
-                                         std::uint32_t open) {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] bool accepts(
+        const TriangleSet<float>::PreparedRay* prepared, std::uint32_t open) {
         const auto& first = prepared[std::countr_zero(open)];
         alignas(32) float values[5][8] = {};
         for (std::uint32_t m = open; m != 0; m &= m - 1) {
@@ -264,14 +273,18 @@ struct alignas(32) PacketTriangleRays {
         return true;
     }
 
-    /// The rays (bits of `rays`) for which triangle `lane` of `block` may be hit; where there
-    /// are some, `sheared` holds every ray's sheared corners (x, y, z of corners 0, 1, 2).
-    [[gnu::target("avx2")]] unsigned candidates(const BvhTriangleBlock& block, int lane,
-                                                unsigned rays, float (&sheared)[9][8]) const {
+    /// The rays (bits of `rays`) for which the triangle of lane `lane` of the group of kWidth
+    /// lanes at `group` (BvhLeafTriangles) may be hit; where there are some, `sheared` holds
+    /// every ray's sheared corners (x, y, z of corners 0, 1, 2).
+    template <int kAxisZ, std::ptrdiff_t kWidth>
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] unsigned candidates(const float* group,
+                                                               std::ptrdiff_t lane, unsigned rays,
+                                                               float (&sheared)[9][8]) const {
         __m256 corners[3][3];
+        const float* column = group + lane;
         for (int k = 0; k < 3; ++k) {
             for (int a = 0; a < 3; ++a)
-                corners[k][a] = _mm256_set1_ps(block.corners[k][axis[a]][lane]);
+                corners[k][a] = _mm256_set1_ps(column[(3 * k + test_axis<kAxisZ>(a)) * kWidth]);
         }
         const Avx2ShearedLanes lanes(corners, origin, shear_x, shear_y);
         const unsigned result = lanes.candidates() & rays;

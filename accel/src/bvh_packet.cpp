@@ -216,7 +216,14 @@ struct BvhTraversal<Set>::Packets {
 #if CSGRT_BVH_AVX2
     /// traverse_packet with the AVX2 node test, everything inlined and compiled for AVX2.
     template <bool kAny>
-    [[gnu::target("avx2"), gnu::flatten]] static void traverse_packet_avx2(
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET), gnu::flatten]] static void traverse_packet_avx2(
+        const Tree& bvh, std::span<const Ray> rays, HitRecord* best, bool* found,
+        QueryScratch& scratch) {
+        traverse_packet<kAny, Avx2NodeTest>(bvh, bvh.nodes_8_, rays, best, found, scratch);
+    }
+    /// traverse_packet_avx2 compiled with AVX-512 allowed (Bvh::uses_avx512).
+    template <bool kAny>
+    [[gnu::target(CSGRT_BVH_AVX512_TARGET), gnu::flatten]] static void traverse_packet_avx512(
         const Tree& bvh, std::span<const Ray> rays, HitRecord* best, bool* found,
         QueryScratch& scratch) {
         traverse_packet<kAny, Avx2NodeTest>(bvh, bvh.nodes_8_, rays, best, found, scratch);
@@ -229,7 +236,7 @@ struct BvhTraversal<Set>::Packets {
     /// and every leaf it reaches is tested for each open ray with that ray's own leaf test and
     /// t_max. The upper bound of the walk is the largest t_max of the open rays.
     template <bool kAny>
-    [[gnu::target("avx2")]] static void walk_interval_packet(
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] static void walk_interval_packet(
         const Tree& bvh, std::span<const Ray> rays, PacketLanes<Avx2NodeTest>& lanes,
         std::uint32_t open, const PacketIntervalTest& test, HitRecord* best, bool* found,
         QueryScratch& scratch) {
@@ -241,7 +248,7 @@ struct BvhTraversal<Set>::Packets {
             return t_max;
         };
         if constexpr (kBlockSet) {
-            if (!bvh.blocks_.empty()) {
+            if (!bvh.leaf_triangles_.empty()) {
                 // Ray-parallel leaves, when the rays share the triangle test's axes.
                 typename Set::PreparedRay prepared[Tree::kPacketRays];
                 for (std::uint32_t m = open; m != 0; m &= m - 1) {
@@ -250,43 +257,74 @@ struct BvhTraversal<Set>::Packets {
                 }
                 PacketTriangleRays triangle_rays;
                 if (triangle_rays.accepts(prepared, open)) {
-                    auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
-                        const BvhTriangleBlock* block = bvh.blocks_.data() + first;
-                        for (std::uint32_t left = count; left != 0; ++block) {
-                            const std::uint32_t block_lanes = std::min(left, kBlockLanes);
-                            left -= block_lanes;
-                            for (std::uint32_t lane = 0; lane < block_lanes; ++lane) {
-                                alignas(32) float sheared[9][8];
-                                unsigned candidates = triangle_rays.candidates(
-                                    *block, static_cast<int>(lane), open, sheared);
-                                while (candidates != 0) {
-                                    const int r = std::countr_zero(candidates);
-                                    candidates &= candidates - 1;
-                                    TriangleSet<float>::ShearedTriangle triangle;
-                                    for (int k = 0; k < 3; ++k) {
-                                        triangle.x[k] = sheared[k][r];
-                                        triangle.y[k] = sheared[3 + k][r];
-                                        triangle.z[k] = sheared[6 + k][r];
-                                    }
-                                    double t, b1, b2;
-                                    if (!TriangleSet<float>::hit_sheared(
-                                            triangle, prepared[r].shear_z, t, b1, b2)) {
-                                        continue;
-                                    }
-                                    if constexpr (kAny) {
-                                        if (t >= prepared[r].t_min && t <= prepared[r].t_max) {
-                                            found[r] = true;
-                                            open &= ~(1u << r);
-                                        }
-                                    } else if (Set::keep_nearest(block->primitive[lane], t, b1, b2,
-                                                                 prepared[r], best[r])) {
-                                        found[r] = true;
-                                        lanes[r].t_max = round_up(best[r].t);
-                                    }
+                    // The triangle of lane `lane` of the group of kWidth lanes at `group`
+                    // against every open ray, for rays whose test axis z is kAxisZ.
+                    auto test_lane = [&]<int kAxisZ, std::ptrdiff_t kWidth>(const float* group,
+                                                                            std::ptrdiff_t lane) {
+                        alignas(32) float sheared[9][8];
+                        unsigned candidates = triangle_rays.template candidates<kAxisZ, kWidth>(
+                            group, lane, open, sheared);
+                        while (candidates != 0) {
+                            const int r = std::countr_zero(candidates);
+                            candidates &= candidates - 1;
+                            TriangleSet<float>::ShearedTriangle triangle;
+                            for (int k = 0; k < 3; ++k) {
+                                triangle.x[k] = sheared[k][r];
+                                triangle.y[k] = sheared[3 + k][r];
+                                triangle.z[k] = sheared[6 + k][r];
+                            }
+                            double t, b1, b2;
+                            if (!TriangleSet<float>::hit_sheared(triangle, prepared[r].shear_z, t,
+                                                                 b1, b2)) {
+                                continue;
+                            }
+                            if constexpr (kAny) {
+                                if (t >= prepared[r].t_min && t <= prepared[r].t_max) {
+                                    found[r] = true;
+                                    open &= ~(1u << r);
                                 }
+                            } else if (Set::keep_nearest(
+                                           std::bit_cast<std::uint32_t>(group[9 * kWidth + lane]),
+                                           t, b1, b2, prepared[r], best[r])) {
+                                found[r] = true;
+                                lanes[r].t_max = round_up(best[r].t);
+                            }
+                        }
+                    };
+                    // The leaf's groups of lanes (BvhLeafTriangles), lane by lane; true when no
+                    // ray is left open.
+                    auto test_leaf = [&]<int kAxisZ>(std::uint32_t first, std::uint32_t count) {
+                        const float* group =
+                            bvh.leaf_triangles_.lanes.data() + kLaneFloats * kBlockLanes * first;
+                        std::uint32_t left = count;
+                        for (; left > kBlockLanes; group += 2 * kBlockLanes * kLaneFloats) {
+                            const std::uint32_t used = std::min(left, 2 * kBlockLanes);
+                            left -= used;
+                            for (std::uint32_t lane = 0; lane < used; ++lane) {
+                                test_lane.template operator()<kAxisZ, 2 * kBlockLanes>(group, lane);
                                 if (open == 0) return true;
                             }
                         }
+                        for (std::uint32_t lane = 0; lane < left; ++lane) {
+                            test_lane.template operator()<kAxisZ, kBlockLanes>(group, lane);
+                            if (open == 0) return true;
+                        }
+                        return false;
+                    };
+                    auto leaf = [&](std::uint32_t first, std::uint32_t count, float& t_max) {
+                        bool done;
+                        switch (triangle_rays.axis[2]) {
+                            case 0:
+                                done = test_leaf.template operator()<0>(first, count);
+                                break;
+                            case 1:
+                                done = test_leaf.template operator()<1>(first, count);
+                                break;
+                            default:
+                                done = test_leaf.template operator()<2>(first, count);
+                                break;
+                        }
+                        if (done) return true;
                         t_max = largest_t_max();
                         return false;
                     };
@@ -310,6 +348,8 @@ struct BvhTraversal<Set>::Packets {
                        QueryScratch& scratch) {
         if (bvh.config_.width == 8) {
 #if CSGRT_BVH_AVX2
+            if (bvh.use_avx512_)
+                return traverse_packet_avx512<kAny>(bvh, rays, best, found, scratch);
             if (bvh.use_avx2_) return traverse_packet_avx2<kAny>(bvh, rays, best, found, scratch);
 #endif
             return traverse_packet<kAny, SseNodeTest<8>>(bvh, bvh.nodes_8_, rays, best, found,

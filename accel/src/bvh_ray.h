@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 
@@ -20,6 +21,12 @@
 // only on a CPU that has it.
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define CSGRT_BVH_AVX2 1
+/// The target of every AVX2 function of the BVH: AVX2 and FMA (build() checks the CPU for both).
+#define CSGRT_BVH_AVX2_TARGET "avx2,fma"
+/// The AVX2 queries compiled once more with AVX-512 (F, VL, BW, DQ) allowed: the same intrinsics,
+/// so the same operations and bits, but 32 vector registers and mask registers to keep the ray's
+/// and the node's values in.
+#define CSGRT_BVH_AVX512_TARGET "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"
 #include <immintrin.h>
 #else
 #define CSGRT_BVH_AVX2 0
@@ -33,15 +40,27 @@ inline constexpr double kFloatMax = std::numeric_limits<float>::max();
 /// slab test (products could overflow or underflow to denormals).
 inline constexpr double kLargestBoxRayValue = 0x1p100;
 inline constexpr float kSlack = Bvh<TriangleSet<float>>::kSlabSlack;
-/// Triangles in a BvhTriangleBlock.
-inline constexpr std::uint32_t kBlockLanes = 4;
+/// Lanes of a leaf's lane group (BvhLeafTriangles): the SSE leaf test's width.
+inline constexpr std::uint32_t kBlockLanes = kBvhLeafLaneGroup;
+
+/// std::nextafter(f, up ? +inf : -inf) for a finite f, from its bits (no library call: the
+/// nearest-hit query rounds every hit's t up).
+inline float next_float(float f, bool up) {
+    const std::uint32_t bits = std::bit_cast<std::uint32_t>(f);
+    if (f == 0.0f) {
+        const float smallest = std::numeric_limits<float>::denorm_min();
+        return up ? smallest : -smallest;
+    }
+    // Away from zero the magnitude grows by one ulp, toward zero it shrinks by one.
+    return std::bit_cast<float>((f > 0.0f) == up ? bits + 1u : bits - 1u);
+}
 
 /// The largest float <= x (x not NaN).
 inline float round_down(double x) {
     if (x > kFloatMax) return static_cast<float>(kFloatMax);
     if (x < -kFloatMax) return -kFloatInfinity;
     float f = static_cast<float>(x);
-    if (double(f) > x) f = std::nextafter(f, -kFloatInfinity);
+    if (double(f) > x) f = next_float(f, false);
     return f;
 }
 
@@ -50,7 +69,7 @@ inline float round_up(double x) {
     if (x > kFloatMax) return kFloatInfinity;
     if (x < -kFloatMax) return -static_cast<float>(kFloatMax);
     float f = static_cast<float>(x);
-    if (double(f) < x) f = std::nextafter(f, kFloatInfinity);
+    if (double(f) < x) f = next_float(f, true);
     return f;
 }
 
@@ -197,6 +216,8 @@ bool hit_box(const BvhNode& node, const BoxRay& ray, float t_max, float& t_enter
 /// the result is never NaN.
 template <int kWidth>
 struct SseNodeTest {
+    /// Few enough values to live in registers while descending (BvhTraversal::walk_wide).
+    static constexpr bool kCopyForDescent = true;
     Float4 origin[3], inverse_near[3], inverse_far[3], t_min;
     int near_row[3], far_row[3];
 
@@ -246,10 +267,11 @@ struct SseNodeTest {
 /// SseNodeTest<8> in one 8-lane AVX step: the same operations, lane by lane, in the same order
 /// (no fused multiply-add), so the same masks and entry distances.
 struct alignas(32) Avx2NodeTest {
+    static constexpr bool kCopyForDescent = true;
     __m256 origin[3], inverse_near[3], inverse_far[3], t_min;
     int near_row[3], far_row[3];
 
-    [[gnu::target("avx2")]] explicit Avx2NodeTest(const BoxRay& ray) {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] explicit Avx2NodeTest(const BoxRay& ray) {
         for (int axis = 0; axis < 3; ++axis) {
             origin[axis] = _mm256_set1_ps(ray.origin[axis]);
             inverse_near[axis] = _mm256_set1_ps(ray.inverse_near[axis]);
@@ -262,7 +284,8 @@ struct alignas(32) Avx2NodeTest {
 
     /// As SseNodeTest<8>::hit; t_enter must be 32-byte aligned.
     template <bool kSigned>
-    [[gnu::target("avx2")]] unsigned hit(const Bvh8Node& node, float t_max, float* t_enter) const {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] unsigned hit(const Bvh8Node& node, float t_max,
+                                                        float* t_enter) const {
         const float* bounds = node.bounds[0];
         __m256 t_near[3], t_far[3];
         for (int axis = 0; axis < 3; ++axis) {
@@ -289,6 +312,109 @@ struct alignas(32) Avx2NodeTest {
 #endif
 
 #if CSGRT_BVH_AVX2
+/// The node test of a ray with BoxRay::fused: each slab distance in one fused multiply-subtract,
+/// fl(b r - fl(o r)) with r = fl(1 / d) (as Embree does), where SseNodeTest rounds twice,
+/// fl(fl(b - o) r'). It is conservative for the same reasons (docs/structures.md): rounding
+/// fl(o r) is the exact product for an origin moved by at most 2^-24 |o| along the axis, and
+/// |o| <= |p| + t |d| for any point p = o + t d of the box, so the move splits into at most
+/// 2^-24 of the box's coordinates (far inside the primitive padding of 2^-18) and at most 2^-24
+/// of the distance t, which with the final rounding and that of r is a relative error of a few
+/// 2^-24 in t. The slack is applied once, at the entry end: t_enter is fl(t0 (1 - 2 kSlabSlack))
+/// with t0 >= t_min >= 0, which widens the interval by 2^-17 of t0, as much as SseNodeTest's
+/// two ends together, far more than the few ulps of error at both ends. No NaN arises: every
+/// r is finite (no direction component is zero), so is fl(o r), and the unused slots' infinite
+/// planes give infinite distances of the right signs.
+struct alignas(32) Avx2FusedNodeTest {
+    static constexpr bool kCopyForDescent = true;
+    __m256 reciprocal[3], origin_reciprocal[3], t_min;
+    /// Byte offsets in a node of the rows of each axis' near and far planes.
+    std::ptrdiff_t near_row[3], far_row[3];
+
+    /// What make() made of a ray.
+    enum class Setup { kTaken, kInvalid, kGeneral };
+
+    /// Sets the test up for `ray` when it qualifies (kTaken): its origin and direction in float
+    /// have every |o| <= 2^100 and every |d| in [2^-100, 2^100] (no zero component), t_min >= 0,
+    /// and each fl(o r) is zero exactly when o is, else a normal float of magnitude at most
+    /// 2^120. Such a ray has a finite origin and a finite non-zero direction, so it is valid
+    /// exactly when t_min <= t_max (kInvalid when not). Any other ray (kGeneral) takes BoxRay,
+    /// which decides its validity, and Avx2NodeTest. Most rays qualify, and this set-up is a
+    /// few dozen instructions in registers.
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] Setup make(const Ray& ray) {
+        const __m256i first_three = _mm256_setr_epi64x(-1, -1, -1, 0);
+        const __m256d origin4 = _mm256_maskload_pd(ray.origin.data(), first_three);
+        const __m256d direction4 = _mm256_blend_pd(
+            _mm256_maskload_pd(ray.direction.data(), first_three), _mm256_set1_pd(ray.t_min), 8);
+        // Lane 3: origin 0, and t_min rounded to nearest in place of a direction component.
+        const __m128 origin = _mm256_cvtpd_ps(origin4);
+        const __m128 direction = _mm256_cvtpd_ps(direction4);
+        const __m128 r = _mm_div_ps(_mm_set1_ps(1.0f), direction);
+        const __m128 origin_r = _mm_mul_ps(origin, r);
+        const __m128 sign = _mm_set1_ps(-0.0f);
+        const __m128 d = _mm_andnot_ps(sign, direction), o = _mm_andnot_ps(sign, origin),
+                     product = _mm_andnot_ps(sign, origin_r);
+        // Each comparison is false for NaN.
+        const __m128 ok = _mm_and_ps(
+            _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(d, _mm_set1_ps(0x1p-100f)),
+                                  _mm_cmple_ps(d, _mm_set1_ps(0x1p100f))),
+                       _mm_and_ps(_mm_cmple_ps(o, _mm_set1_ps(0x1p100f)),
+                                  _mm_cmple_ps(product, _mm_set1_ps(0x1p120f)))),
+            _mm_or_ps(_mm_cmpge_ps(product, _mm_set1_ps(std::numeric_limits<float>::min())),
+                      _mm_cmpeq_ps(origin, _mm_setzero_ps())));
+        if ((_mm_movemask_ps(ok) & 7) != 7 || !(ray.t_min >= 0.0)) return Setup::kGeneral;
+        if (!(ray.t_min <= ray.t_max)) return Setup::kInvalid;
+        // The largest float <= t_min: round_down's result. If rounding to nearest went up,
+        // the float below, whose bits are one less (the rounded value is positive).
+        float lowest = _mm_cvtss_f32(_mm_shuffle_ps(direction, direction, 3));
+        if (double(lowest) > ray.t_min)
+            lowest = std::bit_cast<float>(std::bit_cast<std::uint32_t>(lowest) - 1u);
+        t_min = _mm256_set1_ps(lowest);
+        // Rows 2 axis (lower) and 2 axis + 1 (upper) of 32 bytes; a negative component makes
+        // the upper plane the near one.
+        const std::ptrdiff_t negative = _mm_movemask_ps(direction);
+        for (int axis = 0; axis < 3; ++axis) {
+            const std::ptrdiff_t flip = ((negative >> axis) & 1) * 32;
+            near_row[axis] = 64 * axis + flip;
+            far_row[axis] = 64 * axis + 32 - flip;
+        }
+        const __m256 r8 = _mm256_castps128_ps256(r), origin_r8 = _mm256_castps128_ps256(origin_r);
+        reciprocal[0] = _mm256_permutevar8x32_ps(r8, _mm256_set1_epi32(0));
+        reciprocal[1] = _mm256_permutevar8x32_ps(r8, _mm256_set1_epi32(1));
+        reciprocal[2] = _mm256_permutevar8x32_ps(r8, _mm256_set1_epi32(2));
+        origin_reciprocal[0] = _mm256_permutevar8x32_ps(origin_r8, _mm256_set1_epi32(0));
+        origin_reciprocal[1] = _mm256_permutevar8x32_ps(origin_r8, _mm256_set1_epi32(1));
+        origin_reciprocal[2] = _mm256_permutevar8x32_ps(origin_r8, _mm256_set1_epi32(2));
+        return Setup::kTaken;
+    }
+
+    /// The eight children's distances to the planes of row `row` along `axis`.
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] __m256 distance(const Bvh8Node& node, std::ptrdiff_t row,
+                                                           int axis) const {
+        const float* plane =
+            reinterpret_cast<const float*>(reinterpret_cast<const char*>(node.bounds) + row);
+        return _mm256_fmsub_ps(_mm256_load_ps(plane), reciprocal[axis], origin_reciprocal[axis]);
+    }
+
+    /// As Avx2NodeTest::hit<false>; t_enter must be 32-byte aligned.
+    template <bool kSigned>
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] unsigned hit(const Bvh8Node& node, float t_max,
+                                                        float* t_enter) const {
+        static_assert(!kSigned, "rays with signed intervals take Avx2NodeTest");
+        // Accumulated plane by plane, which keeps few values live at once.
+        __m256 t0 = _mm256_max_ps(distance(node, near_row[0], 0), t_min);
+        t0 = _mm256_max_ps(t0, distance(node, near_row[1], 1));
+        t0 = _mm256_max_ps(t0, distance(node, near_row[2], 2));
+        __m256 t1 = _mm256_min_ps(distance(node, far_row[0], 0), _mm256_set1_ps(t_max));
+        t1 = _mm256_min_ps(t1, distance(node, far_row[1], 1));
+        t1 = _mm256_min_ps(t1, distance(node, far_row[2], 2));
+        t0 = _mm256_mul_ps(t0, _mm256_set1_ps(1.0f - 2.0f * kSlack));
+        _mm256_store_ps(t_enter, t0);
+        return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+    }
+};
+#endif
+
+#if CSGRT_BVH_AVX2
 /// The node test of a packet of rays whose directions share their signs, taken as intervals
 /// (interval arithmetic culling: Wald, Boulos and Shirley, "Ray Tracing Deformable Scenes
 /// Using Dynamic Bounding Volume Hierarchies", ACM TOG 2007). On each axis the rays' origins
@@ -305,6 +431,8 @@ struct alignas(32) Avx2NodeTest {
 /// signed-interval widening are not accepted, nor packets without a common origin; those go
 /// one ray at a time.
 struct alignas(32) PacketIntervalTest {
+    /// Nineteen vectors: more than the registers hold, so a descent reads them where they are.
+    static constexpr bool kCopyForDescent = false;
     __m256 near_origin[3], far_origin[3], near_low[3], near_high[3], far_low[3], far_high[3];
     __m256 t_min;
     int near_row[3], far_row[3];
@@ -312,7 +440,7 @@ struct alignas(32) PacketIntervalTest {
     /// Whether the open rays of `lanes` (bits of `open`) can be walked as one; if so, sets the
     /// test up.
     template <class Lanes>
-    [[gnu::target("avx2")]] bool accepts(const Lanes& lanes, std::uint32_t open) {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] bool accepts(const Lanes& lanes, std::uint32_t open) {
         const BoxRay& first = lanes[std::countr_zero(open)].box;
         float o_low[3], o_high[3], n_low[3], n_high[3], f_low[3], f_high[3];
         float lowest_t_min = kFloatInfinity;
@@ -362,7 +490,8 @@ struct alignas(32) PacketIntervalTest {
 
     /// As Avx2NodeTest::hit<false> for the whole packet; t_enter must be 32-byte aligned.
     template <bool kSigned>
-    [[gnu::target("avx2")]] unsigned hit(const Bvh8Node& node, float t_max, float* t_enter) const {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] unsigned hit(const Bvh8Node& node, float t_max,
+                                                        float* t_enter) const {
         static_assert(!kSigned, "packets with signed intervals are walked ray by ray");
         const float* bounds = node.bounds[0];
         __m256 t_near[3], t_far[3];

@@ -37,43 +37,62 @@ struct BvhTraversal {
         float t_enter;
     };
 
-    /// Visits every leaf the ray may hit within [t_min, t_max], nearest entry first. `leaf`
-    /// is called as leaf(first, count, t_max) with the leaf's reference (see Bvh::
-    /// binary_nodes) and the float upper bound of the interval, which it may lower; it
-    /// returns true to stop. kAvx2: the 8-wide tree with the AVX2 node test (run_avx2 only).
+    /// Visits every leaf the ray may hit within [t_min, t_max], nearest entry first, and
+    /// returns whether the ray is valid (is_valid; an invalid ray visits nothing). `leaf` is
+    /// called as leaf(first, count, t_max) with the leaf's reference (see Bvh::binary_nodes)
+    /// and the float upper bound of the interval, which it may lower; it returns true to stop.
+    /// kAvx2: the 8-wide tree with the AVX2 node tests (run_avx2 and run_avx512 only).
     template <bool kCount, bool kAvx2, class Leaf>
-    static void traverse(const Tree& bvh, const Ray& ray, const BoxRay& box_ray,
-                         TraversalCounters& counters, Leaf& leaf) {
+    static bool traverse(const Tree& bvh, const Ray& ray, TraversalCounters& counters, Leaf& leaf) {
 #if CSGRT_BVH_AVX2
         if constexpr (kAvx2) {
-            if (box_ray.signed_interval) {
-                return traverse_wide<kCount, true, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray,
-                                                                 ray.t_max, counters, leaf);
+            // Nearly every ray takes the fused test; the others (a signed interval, a zero
+            // direction component, an extreme origin or direction) take Avx2NodeTest's signed
+            // form, which is conservative for t_min >= 0 too (it only widens more).
+            Avx2FusedNodeTest fused;
+            switch (fused.make(ray)) {
+                case Avx2FusedNodeTest::Setup::kTaken:
+                    if (!bvh.nodes_8_.empty()) {
+                        walk_wide<kCount, false>(bvh, bvh.nodes_8_, fused, round_up(ray.t_max),
+                                                 counters, leaf);
+                    }
+                    return true;
+                case Avx2FusedNodeTest::Setup::kInvalid:
+                    return false;
+                case Avx2FusedNodeTest::Setup::kGeneral:
+                    break;
             }
-            return traverse_wide<kCount, false, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray, ray.t_max,
-                                                              counters, leaf);
+            const BoxRay box_ray(ray);
+            if (!box_ray.valid) return false;
+            traverse_wide<kCount, true, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray, ray.t_max,
+                                                      counters, leaf);
+            return true;
         }
 #endif
+        const BoxRay box_ray(ray);
+        if (!box_ray.valid) return false;
         if (bvh.config_.width == 8) {
             if (box_ray.signed_interval) {
-                return traverse_wide<kCount, true, SseNodeTest<8>>(bvh, bvh.nodes_8_, box_ray,
-                                                                   ray.t_max, counters, leaf);
+                traverse_wide<kCount, true, SseNodeTest<8>>(bvh, bvh.nodes_8_, box_ray, ray.t_max,
+                                                            counters, leaf);
+            } else {
+                traverse_wide<kCount, false, SseNodeTest<8>>(bvh, bvh.nodes_8_, box_ray, ray.t_max,
+                                                             counters, leaf);
             }
-            return traverse_wide<kCount, false, SseNodeTest<8>>(bvh, bvh.nodes_8_, box_ray,
-                                                                ray.t_max, counters, leaf);
-        }
-        if (bvh.config_.width == 4) {
+        } else if (bvh.config_.width == 4) {
             if (box_ray.signed_interval) {
-                return traverse_wide<kCount, true, SseNodeTest<4>>(bvh, bvh.nodes_4_, box_ray,
-                                                                   ray.t_max, counters, leaf);
+                traverse_wide<kCount, true, SseNodeTest<4>>(bvh, bvh.nodes_4_, box_ray, ray.t_max,
+                                                            counters, leaf);
+            } else {
+                traverse_wide<kCount, false, SseNodeTest<4>>(bvh, bvh.nodes_4_, box_ray, ray.t_max,
+                                                             counters, leaf);
             }
-            return traverse_wide<kCount, false, SseNodeTest<4>>(bvh, bvh.nodes_4_, box_ray,
-                                                                ray.t_max, counters, leaf);
+        } else if (box_ray.signed_interval) {
+            traverse_binary<kCount, true>(bvh, box_ray, ray.t_max, counters, leaf);
+        } else {
+            traverse_binary<kCount, false>(bvh, box_ray, ray.t_max, counters, leaf);
         }
-        if (box_ray.signed_interval) {
-            return traverse_binary<kCount, true>(bvh, box_ray, ray.t_max, counters, leaf);
-        }
-        traverse_binary<kCount, false>(bvh, box_ray, ray.t_max, counters, leaf);
+        return true;
     }
 
     /// One query of kind kKind, with the AVX2 node test when kAvx2.
@@ -96,10 +115,16 @@ struct BvhTraversal {
     /// set-up, the traversal, the leaf visitor, the triangle test), so all of it is AVX2 code,
     /// here and nowhere else, with no call between the set-up and the traversal.
     template <QueryKind kKind, bool kCount>
-    [[gnu::target("avx2"), gnu::flatten]] static bool run_avx2(const Tree& bvh, const Ray& ray,
-                                                               QueryAnswer<kKind>& answer,
-                                                               QueryScratch& scratch,
-                                                               TraversalCounters& counters) {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET), gnu::flatten]] static bool run_avx2(
+        const Tree& bvh, const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+        TraversalCounters& counters) {
+        return run<kKind, kCount, true>(bvh, ray, answer, scratch, counters);
+    }
+    /// run_avx2's code compiled with AVX-512 allowed (Bvh::uses_avx512).
+    template <QueryKind kKind, bool kCount>
+    [[gnu::target(CSGRT_BVH_AVX512_TARGET), gnu::flatten]] static bool run_avx512(
+        const Tree& bvh, const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
+        TraversalCounters& counters) {
         return run<kKind, kCount, true>(bvh, ray, answer, scratch, counters);
     }
 #endif
@@ -120,8 +145,9 @@ struct BvhTraversal {
         };
         if (count == WideBvhNode<kWidth>::kInterior) {
             fetch(&nodes[first], sizeof(WideBvhNode<kWidth>));
-        } else if (!bvh.blocks_.empty()) {
-            fetch(&bvh.blocks_[first], sizeof(BvhTriangleBlock) + 32);
+        } else if (!bvh.leaf_triangles_.empty()) {
+            // The first three lines of the leaf's lanes: all of a group of four.
+            fetch(bvh.leaf_triangles_.lanes.data() + kLaneFloats * kBlockLanes * first, 192);
         } else if (count == 1) {
             if constexpr (requires { bvh.set_->corner(std::size_t{0}, 0); }) {
                 const auto* corners = &bvh.set_->corner(first, 0);
@@ -202,6 +228,14 @@ struct BvhTraversal {
         std::uint32_t first = 0, count = Node::kInterior;
         alignas(32) float t_enter[kWidth];
         for (;;) {
+            // A small node test is copied for each descent (NodeTest::kCopyForDescent): that
+            // keeps its values in registers while descending, where otherwise they would stay
+            // live (and, for want of registers, in memory) across the leaf tests between
+            // descents. The empty asm says that `test` may have changed, so that the compiler
+            // reads it afresh rather than reuse the values read for the previous descent.
+            if constexpr (NodeTest::kCopyForDescent) asm("" : : "r"(&test) : "memory");
+            const std::conditional_t<NodeTest::kCopyForDescent, NodeTest, const NodeTest&>
+                descent_test = test;
             // Descend through interior nodes, nearest child first, until a leaf or a dead end.
             while (count == Node::kInterior) {
                 const Node& node = nodes[first];
@@ -209,7 +243,7 @@ struct BvhTraversal {
                     ++counters.nodes_visited;
                     counters.boxes_tested += kWidth;
                 }
-                unsigned mask = test.template hit<kSigned>(node, t_max, t_enter);
+                unsigned mask = descent_test.template hit<kSigned>(node, t_max, t_enter);
                 if (mask == 0) break;
                 const int nearest = std::countr_zero(mask);
                 mask &= mask - 1;
@@ -324,60 +358,18 @@ struct BvhTraversal {
     static bool for_each_hit(const Tree& bvh, const LeafRayOf<kWide>& ray, std::uint32_t first,
                              std::uint32_t count, TraversalCounters& counters, Visit&& visit) {
         if constexpr (kBlockSet) {
-            if (!bvh.blocks_.empty()) {
-                // The candidate lanes of one block, finished by BlockHits (or by the set's
-                // test where an edge function is zero) and handed to visit.
-                auto visit_block = [&](const BvhTriangleBlock& block, const ShearedBlock& sheared,
-                                       unsigned candidates, unsigned zeros) {
-                    const BlockHits hits(sheared, ray.prepared.shear_z);
-                    do {
-                        const int lane = std::countr_zero(candidates);
-                        candidates &= candidates - 1;
-                        double t = hits.t[lane], b1 = hits.b1[lane], b2 = hits.b2[lane];
-                        if ((zeros >> lane & 1u) != 0 &&
-                            !TriangleSet<float>::hit_sheared(sheared.lane(lane),
-                                                             ray.prepared.shear_z, t, b1, b2)) {
-                            continue;
-                        }
-                        if (visit(BlockCandidate{block.primitive[lane], t, b1, b2, ray.prepared}))
-                            return true;
-                    } while (candidates != 0);
-                    return false;
-                };
-                const BvhTriangleBlock* block = bvh.blocks_.data() + first;
-                std::uint32_t left = count;
-                if constexpr (LeafRayOf<kWide>::kPairs) {
-                    for (; left > kBlockLanes; block += 2) {
-                        const std::uint32_t lanes = std::min(left, 2 * kBlockLanes);
-                        left -= lanes;
-                        if constexpr (kCount) counters.primitives_tested += lanes;
-                        ShearedBlock sheared[2];
-                        unsigned zeros;
-                        const unsigned candidates =
-                            ray.wide.candidates(block[0], block[1], sheared, zeros) &
-                            ((1u << lanes) - 1u);
-                        if ((candidates & 0xfu) != 0 &&
-                            visit_block(block[0], sheared[0], candidates & 0xfu, zeros & 0xfu)) {
-                            return true;
-                        }
-                        if ((candidates >> 4) != 0 &&
-                            visit_block(block[1], sheared[1], candidates >> 4, zeros >> 4)) {
-                            return true;
-                        }
-                    }
+            if (!bvh.leaf_triangles_.empty()) {
+                switch (ray.prepared.axis_z) {
+                    case 0:
+                        return for_each_hit_in_lanes<kCount, kWide, 0>(bvh, ray, first, count,
+                                                                       counters, visit);
+                    case 1:
+                        return for_each_hit_in_lanes<kCount, kWide, 1>(bvh, ray, first, count,
+                                                                       counters, visit);
+                    default:
+                        return for_each_hit_in_lanes<kCount, kWide, 2>(bvh, ray, first, count,
+                                                                       counters, visit);
                 }
-                for (; left != 0; ++block) {
-                    const std::uint32_t lanes = std::min(left, kBlockLanes);
-                    left -= lanes;
-                    if constexpr (kCount) counters.primitives_tested += lanes;
-                    ShearedBlock sheared;
-                    unsigned zeros;
-                    const unsigned candidates =
-                        ray.block.candidates(*block, sheared, zeros) & ((1u << lanes) - 1u);
-                    if (candidates != 0 && visit_block(*block, sheared, candidates, zeros))
-                        return true;
-                }
-                return false;
             }
         }
         const Set& set = *bvh.set_;
@@ -389,6 +381,81 @@ struct BvhTraversal {
         for (std::uint32_t i = 0; i != count; ++i) {
             if constexpr (kCount) ++counters.primitives_tested;
             if (visit(PrimitiveCandidate{set, indices[i], ray.prepared})) return true;
+        }
+        return false;
+    }
+
+    /// for_each_hit on a leaf of triangle lanes (BvhLeafTriangles), for rays whose test axis z
+    /// is kAxisZ.
+    template <bool kCount, bool kWide, int kAxisZ, class Visit>
+    static bool for_each_hit_in_lanes(const Tree& bvh, const LeafRayOf<kWide>& ray,
+                                      std::uint32_t first, std::uint32_t count,
+                                      TraversalCounters& counters, Visit& visit) {
+        // The candidate lanes of four, finished by BlockHits (or by the set's test where
+        // an edge function is zero) and handed to visit; `primitives` holds the four
+        // lanes' triangle indices as float bits.
+        auto visit_lanes = [&](const float* primitives, const ShearedBlock& sheared,
+                               unsigned candidates, unsigned zeros) {
+            const BlockHits hits(sheared, ray.prepared.shear_z);
+            do {
+                const int lane = std::countr_zero(candidates);
+                candidates &= candidates - 1;
+                double t = hits.t[lane], b1 = hits.b1[lane], b2 = hits.b2[lane];
+                if ((zeros >> lane & 1u) != 0 &&
+                    !TriangleSet<float>::hit_sheared(sheared.lane(lane), ray.prepared.shear_z, t,
+                                                     b1, b2)) {
+                    continue;
+                }
+                const auto index = std::bit_cast<std::uint32_t>(primitives[lane]);
+                if (visit(BlockCandidate{index, t, b1, b2, ray.prepared})) return true;
+            } while (candidates != 0);
+            return false;
+        };
+        // Groups of eight lanes while more than four are left, then one of four
+        // (BvhLeafTriangles).
+        const float* group = bvh.leaf_triangles_.lanes.data() + kLaneFloats * kBlockLanes * first;
+        std::uint32_t left = count;
+        for (; left > kBlockLanes; group += 8 * kLaneFloats) {
+            const std::uint32_t lanes = std::min(left, 2 * kBlockLanes);
+            left -= lanes;
+            if constexpr (kCount) counters.primitives_tested += lanes;
+            const unsigned used = (1u << lanes) - 1u;
+            if constexpr (LeafRayOf<kWide>::kPairs) {
+                // Both halves in one 8-lane step, each split off only when it holds a
+                // candidate.
+                const Avx2ShearedLanes sheared = ray.wide.template shear<kAxisZ>(group);
+                const unsigned candidates = sheared.candidates() & used;
+                if ((candidates & 0xfu) != 0 &&
+                    visit_lanes(group + 72, sheared.half(0), candidates & 0xfu,
+                                sheared.zeros & 0xfu)) {
+                    return true;
+                }
+                if ((candidates >> 4) != 0 &&
+                    visit_lanes(group + 76, sheared.half(1), candidates >> 4, sheared.zeros >> 4)) {
+                    return true;
+                }
+            } else {
+                for (int half = 0; half < 2; ++half) {
+                    ShearedBlock sheared;
+                    unsigned zeros;
+                    const unsigned candidates =
+                        ray.block.template candidates<kAxisZ, 8>(group + 4 * half, sheared, zeros) &
+                        (used >> (4 * half));
+                    if (candidates != 0 &&
+                        visit_lanes(group + 72 + 4 * half, sheared, candidates, zeros)) {
+                        return true;
+                    }
+                }
+            }
+        }
+        if (left != 0) {
+            if constexpr (kCount) counters.primitives_tested += left;
+            ShearedBlock sheared;
+            unsigned zeros;
+            const unsigned candidates =
+                ray.block.template candidates<kAxisZ, 4>(group, sheared, zeros) &
+                ((1u << left) - 1u);
+            if (candidates != 0 && visit_lanes(group + 36, sheared, candidates, zeros)) return true;
         }
         return false;
     }
@@ -419,8 +486,6 @@ struct BvhTraversal {
     static bool intersect(const Tree& bvh, const Ray& ray, HitRecord& record, QueryScratch& scratch,
                           TraversalCounters& counters) {
         if (bvh.set_ == nullptr) return false;
-        const BoxRay box_ray(ray);
-        if (!box_ray.valid) return false;
         // The leaf ray is made at the first leaf: most camera rays reach none (they miss the
         // mesh's boxes), and for them the set's prepare and the block ray are pure cost.
         // Raw storage rather than std::optional: LeafRay is trivially destructible, so nothing
@@ -438,7 +503,7 @@ struct BvhTraversal {
             found |= nearest_in_leaf<kCount>(bvh, *leaf_ray, first, count, best, t_max, counters);
             return false;
         };
-        traverse<kCount, kAvx2>(bvh, ray, box_ray, counters, leaf);
+        traverse<kCount, kAvx2>(bvh, ray, counters, leaf);
         if (found) record = best;
         return found;
     }
@@ -447,16 +512,15 @@ struct BvhTraversal {
     static bool occluded(const Tree& bvh, const Ray& ray, QueryScratch& scratch,
                          TraversalCounters& counters) {
         if (bvh.set_ == nullptr) return false;
-        const BoxRay box_ray(ray);
-        if (!box_ray.valid) return false;
         // Made up front, unlike intersect's: shadow rays start on a surface and nearly all
-        // reach a leaf, and the deferred form cost them 58 instructions a ray (callgrind).
+        // reach a leaf, and the deferred form cost them 58 instructions a ray (callgrind). (An
+        // invalid ray makes it for nothing: the set's prepare is plain arithmetic.)
         const LeafRayOf<kAvx2> leaf_ray(*bvh.set_, ray, scratch);
         bool occluded = false;
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
             return occluded = occluded_in_leaf<kCount>(bvh, leaf_ray, first, count, counters);
         };
-        traverse<kCount, kAvx2>(bvh, ray, box_ray, counters, leaf);
+        traverse<kCount, kAvx2>(bvh, ray, counters, leaf);
         return occluded;
     }
 
@@ -466,8 +530,6 @@ struct BvhTraversal {
     static void all_hits(const Tree& bvh, const Ray& ray, std::vector<HitRecord>& hits,
                          QueryScratch& scratch, TraversalCounters& counters) {
         if (bvh.set_ == nullptr) return;
-        const BoxRay box_ray(ray);
-        if (!box_ray.valid) return;
         const LeafRayOf<kAvx2> leaf_ray(*bvh.set_, ray, scratch);
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
             return for_each_hit<kCount>(bvh, leaf_ray, first, count, counters,
@@ -479,7 +541,7 @@ struct BvhTraversal {
                                             return false;
                                         });
         };
-        traverse<kCount, kAvx2>(bvh, ray, box_ray, counters, leaf);
+        traverse<kCount, kAvx2>(bvh, ray, counters, leaf);
     }
 
     /// The packet queries (bvh_packet.cpp): a member, so that they share the traversal's

@@ -419,7 +419,7 @@ TEST(Bvh, TriangleBlocksGiveTheScalarTestsBitsOnEdgeAndVertexRays) {
         Bvh<TriangleSet<float>> avx2, sse;
         avx2.build(set);
         sse.build(set, BvhConfig{.avx2 = false});
-        ASSERT_FALSE(avx2.triangle_blocks().empty());
+        ASSERT_FALSE(avx2.leaf_triangles().empty());
         const Aabb box = mesh_box(mesh);
         QueryScratch scratch;
         int failures = 0;
@@ -485,35 +485,68 @@ TEST(Bvh, TriangleBlocksGiveTheScalarTestsBitsOnEdgeAndVertexRays) {
 }
 
 TEST(Bvh, Avx2AndSseTraversalsDoTheSameWorkRayByRay) {
-    // The AVX2 node test does the SSE test's float operations in one 8-lane step, so both
-    // enter the same children at the same distances: equal answers and equal counters, ray
-    // by ray. (On a CPU without AVX2 both run the SSE code and the test proves nothing.)
-    // One difference is by design: the AVX2 leaf tests two triangle blocks in one step, so
-    // an occlusion query that the SSE leaf stops after a leaf's first block has tested the
-    // second block's triangles too (at most 4 more; nearest-hit queries test every block).
+    // Rays with a signed interval (t_min < 0) take the AVX2 node test that does the SSE test's
+    // float operations in one 8-lane step, so both enter the same children at the same
+    // distances: equal answers and equal counters, ray by ray. (On a CPU without AVX2 both run
+    // the SSE code and the test proves nothing.) One difference is by design: the AVX2 leaf
+    // tests a group of eight lanes in one step, so an occlusion query that the SSE leaf stops
+    // after the group's first four has tested the other four too (at most 4 more triangles;
+    // nearest-hit queries test every lane).
+    //
+    // The other rays take the fused node test (Avx2FusedNodeTest: one rounding per slab
+    // distance instead of two, the slack at the entry end only), which can disagree with the
+    // SSE test about a box, or about which of two children is nearer, only where the distances
+    // involved lie within a few 2^-17 of each other relative to their size. Answers stay equal
+    // ray by ray (both tests are conservative and the set's tie rule decides); the counters
+    // may differ on such rays. With 30-40 boxes tested a ray at distances spread over the
+    // ray's span, that is about 30 * 2^-16 = 5e-4 of the rays; at most 1% of them may differ,
+    // and the totals within 0.1% of each other.
     const TestMesh mesh = test::sphere_mesh(5);
     const TriangleSet<float> set(mesh.vertices, mesh.triangles);
     Bvh<TriangleSet<float>> avx2, sse;
     avx2.build(set);
     sse.build(set, BvhConfig{.avx2 = false});
     EXPECT_FALSE(sse.uses_avx2());
+    EXPECT_FALSE(sse.uses_avx512());
+    EXPECT_TRUE(avx2.uses_avx2() || !avx2.uses_avx512());
     if (!avx2.uses_avx2()) GTEST_SKIP() << "this CPU has no AVX2";
     QueryScratch scratch;
+    int signed_rays = 0, fused_rays = 0, differing_rays = 0;
+    std::size_t nodes_avx2 = 0, nodes_sse = 0, primitives_avx2 = 0, primitives_sse = 0;
     for (const Ray& ray : mixed_rays(mesh_box(mesh), 20000, 18)) {
         TraversalCounters a, b;
         HitRecord ra, rb;
         const Answer answer_a = Answer::of(avx2.intersect_counted(ray, ra, scratch, a), ra);
         const Answer answer_b = Answer::of(sse.intersect_counted(ray, rb, scratch, b), rb);
         ASSERT_EQ(answer_a, answer_b) << describe(ray);
-        ASSERT_EQ(a.nodes_visited, b.nodes_visited) << describe(ray);
-        ASSERT_EQ(a.boxes_tested, b.boxes_tested) << describe(ray);
-        ASSERT_EQ(a.primitives_tested, b.primitives_tested) << describe(ray);
         TraversalCounters c, d;
-        ASSERT_EQ(avx2.occluded_counted(ray, scratch, c), sse.occluded_counted(ray, scratch, d));
-        ASSERT_EQ(c.nodes_visited, d.nodes_visited) << describe(ray);
-        ASSERT_GE(c.primitives_tested, d.primitives_tested) << describe(ray);
-        ASSERT_LE(c.primitives_tested, d.primitives_tested + 4) << describe(ray);
+        ASSERT_EQ(avx2.occluded_counted(ray, scratch, c), sse.occluded_counted(ray, scratch, d))
+            << describe(ray);
+        if (!(ray.t_min >= 0.0)) {
+            ++signed_rays;
+            ASSERT_EQ(a.nodes_visited, b.nodes_visited) << describe(ray);
+            ASSERT_EQ(a.boxes_tested, b.boxes_tested) << describe(ray);
+            ASSERT_EQ(a.primitives_tested, b.primitives_tested) << describe(ray);
+            ASSERT_EQ(c.nodes_visited, d.nodes_visited) << describe(ray);
+            ASSERT_GE(c.primitives_tested, d.primitives_tested) << describe(ray);
+            ASSERT_LE(c.primitives_tested, d.primitives_tested + 4) << describe(ray);
+            continue;
+        }
+        ++fused_rays;
+        if (a.nodes_visited != b.nodes_visited || a.primitives_tested != b.primitives_tested ||
+            c.nodes_visited != d.nodes_visited) {
+            ++differing_rays;
+        }
+        nodes_avx2 += a.nodes_visited + c.nodes_visited;
+        nodes_sse += b.nodes_visited + d.nodes_visited;
+        primitives_avx2 += a.primitives_tested;
+        primitives_sse += b.primitives_tested;
     }
+    EXPECT_GT(signed_rays, 1000);
+    EXPECT_GT(fused_rays, 10000);
+    EXPECT_LE(differing_rays, fused_rays / 100);
+    EXPECT_NEAR(double(nodes_avx2), double(nodes_sse), 1e-3 * double(nodes_sse));
+    EXPECT_NEAR(double(primitives_avx2), double(primitives_sse), 1e-3 * double(primitives_sse));
 }
 
 TEST(Bvh, EmptySetAndSinglePrimitive) {
@@ -650,13 +683,17 @@ template <class Set>
 std::vector<std::uint32_t> leaf_primitives(const Bvh<Set>& bvh, const Set& set, std::uint32_t first,
                                            std::uint32_t count) {
     std::vector<std::uint32_t> primitives;
-    const auto& blocks = bvh.triangle_blocks();
-    if (!blocks.empty()) {
-        for (std::uint32_t k = 0; k < (count + 3) / 4 * 4; ++k) {
-            EXPECT_LT(first + k / 4, blocks.size());
-            if (first + k / 4 >= blocks.size()) break;
-            const BvhTriangleBlock& block = blocks[first + k / 4];
-            const std::uint32_t primitive = block.primitive[k % 4];
+    const BvhLeafTriangles& triangles = bvh.leaf_triangles();
+    if (!triangles.empty()) {
+        // Lanes 4 first .. 4 first + 4 ceil(count / 4) - 1: groups of eight while more than
+        // four are left, then one of four; each lane's nine corners and index (BvhLeafTriangles).
+        const std::uint32_t lanes = (count + 3) / 4 * 4;
+        EXPECT_LE(10 * (std::size_t{4} * first + lanes), triangles.lanes.size());
+        if (10 * (std::size_t{4} * first + lanes) > triangles.lanes.size()) return primitives;
+        for (std::uint32_t k = 0; k < lanes; ++k) {
+            const auto at = BvhLeafTriangles::place(first, count, k);
+            EXPECT_EQ(at.width, k / 8 * 8 + 4 < count ? 8u : 4u);
+            const std::uint32_t primitive = triangles.primitive(at);
             if (k >= count) {
                 EXPECT_EQ(primitive, kNoIndex);
                 continue;
@@ -668,7 +705,7 @@ std::vector<std::uint32_t> leaf_primitives(const Bvh<Set>& bvh, const Set& set, 
                 for (int corner = 0; corner < 3; ++corner) {
                     for (int axis = 0; axis < 3; ++axis) {
                         EXPECT_EQ(
-                            std::bit_cast<std::uint32_t>(block.corners[corner][axis][k % 4]),
+                            std::bit_cast<std::uint32_t>(triangles.corner(at, corner, axis)),
                             std::bit_cast<std::uint32_t>(set.corner(primitive, corner)[axis]));
                     }
                 }
@@ -774,7 +811,7 @@ TEST(Bvh, TreeInvariantsAndStats) {
             Bvh<TriangleSet<float>> bvh;
             bvh.build(set, config);
             expect_valid_tree(bvh, set, width);
-            EXPECT_EQ(bvh.triangle_blocks().empty(), !blocks);
+            EXPECT_EQ(bvh.leaf_triangles().empty(), !blocks);
             EXPECT_EQ(bvh.primitive_indices().empty(), blocks);
             const AcceleratorStats stats = bvh.stats();
             EXPECT_EQ(stats.name, "bvh");

@@ -32,8 +32,9 @@ struct BvhTraversal;
 ///
 /// Traversal is near child first (by entry distance), with a fixed stack on the C++ stack;
 /// subtrees whose entry lies beyond the nearest hit so far are skipped. For TriangleSet<float>
-/// the leaves hold their triangles four to a block (BvhConfig::triangle_blocks), tested with
-/// SIMD lane by lane in exactly the set's float arithmetic, so the answers stay the set's own.
+/// the leaves hold their triangles as structure of arrays in lanes of four
+/// (BvhConfig::triangle_blocks, BvhLeafTriangles), tested four or eight at a time with SIMD lane
+/// by lane in exactly the set's float arithmetic, so the answers stay the set's own.
 template <class Set>
 class Bvh final : public AcceleratorBase<Bvh<Set>, Set> {
 public:
@@ -67,10 +68,10 @@ public:
                                  QueryScratch& scratch) const;
 
     /// The binary nodes (width 2), the 4- or 8-wide nodes (width 4 or 8; each empty for the
-    /// other widths), and the leaves' contents: primitive indices in leaf order, or triangle
-    /// blocks (TriangleSet<float> with triangle_blocks; the indices are then empty). A leaf
-    /// child (offset or first, count) names `count` primitives: with blocks, those of blocks
-    /// first .. first + ceil(count / 4) - 1; else the primitive `first` itself when count is
+    /// other widths), and the leaves' contents: primitive indices in leaf order, or the leaves'
+    /// triangles (TriangleSet<float> with triangle_blocks; the indices are then empty). A leaf
+    /// child (offset or first, count) names `count` primitives: with leaf triangles, the lanes
+    /// from 4 first on (see BvhLeafTriangles); else the primitive `first` itself when count is
     /// 1 (saving a dependent load), or index entries first .. first + count - 1. For tests of
     /// the tree's invariants.
     const std::vector<BvhNode, AlignedAllocator<BvhNode>>& binary_nodes() const {
@@ -79,12 +80,12 @@ public:
     const WideBvhNodes<4>& nodes_4_wide() const { return nodes_4_; }
     const WideBvhNodes<8>& nodes_8_wide() const { return nodes_8_; }
     const std::vector<std::uint32_t>& primitive_indices() const { return indices_; }
-    const std::vector<BvhTriangleBlock, AlignedAllocator<BvhTriangleBlock>>& triangle_blocks()
-        const {
-        return blocks_;
-    }
-    /// Whether queries run the AVX2 node test (BvhConfig::avx2 and a CPU that has it).
+    const BvhLeafTriangles& leaf_triangles() const { return leaf_triangles_; }
+    /// Whether queries run the AVX2 node test (BvhConfig::avx2 and a CPU that has AVX2 and FMA).
     bool uses_avx2() const { return use_avx2_; }
+    /// Whether they run it compiled with AVX-512 allowed (uses_avx2() and a CPU with AVX-512 F,
+    /// VL, BW and DQ): the same operations, so the same answers and counters.
+    bool uses_avx512() const { return use_avx512_; }
 
 private:
     friend struct detail::BvhTraversal<Set>;
@@ -94,18 +95,19 @@ private:
     std::size_t trace_packets(std::span<const Ray> rays, std::span<HitRecord> records,
                               std::span<bool> hit, QueryScratch& scratch) const;
 
-    /// Copies the triangles of each leaf of `tree` into blocks_, in leaf order, and points
-    /// the leaves at their first block (TriangleSet<float> only).
-    void fill_blocks(const Set& set, detail::BinaryBvh& tree, bool parallel);
+    /// Copies the triangles of each leaf of `tree` into leaf_triangles_, in leaf order, and
+    /// points the leaves at their first lane group (TriangleSet<float> only).
+    void fill_leaf_triangles(const Set& set, detail::BinaryBvh& tree, bool parallel);
 
     const Set* set_ = nullptr;
     BvhConfig config_;
     bool use_avx2_ = false;
+    bool use_avx512_ = false;
     std::vector<BvhNode, AlignedAllocator<BvhNode>> binary_nodes_;
     WideBvhNodes<4> nodes_4_;
     WideBvhNodes<8> nodes_8_;
     std::vector<std::uint32_t> indices_;
-    std::vector<BvhTriangleBlock, AlignedAllocator<BvhTriangleBlock>> blocks_;
+    BvhLeafTriangles leaf_triangles_;
 };
 
 class ShapeSet;

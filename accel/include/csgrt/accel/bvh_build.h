@@ -1,5 +1,6 @@
 #pragma once
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <new>
@@ -47,16 +48,9 @@ using Bvh4Node = WideBvhNode<4>;
 using Bvh8Node = WideBvhNode<8>;
 static_assert(sizeof(Bvh4Node) == 128 && sizeof(Bvh8Node) == 256);
 
-/// Four triangles of a leaf as the BVH stores them for TriangleSet<float> (see
-/// BvhConfig::triangle_blocks): coordinate `axis` of corner k of lane l at
-/// corners[k][axis][l], as the set stores it, and each lane's triangle index. A leaf of n
-/// triangles is ceil(n / 4) consecutive blocks; lanes past n hold zeros and kNoIndex and are
-/// never tested. 160 bytes: 40 a triangle when full.
-struct alignas(32) BvhTriangleBlock {
-    float corners[3][3][4];
-    std::uint32_t primitive[4];
-};
-static_assert(sizeof(BvhTriangleBlock) == 160);
+/// Four lanes: a leaf of n triangles in a BvhLeafTriangles owns ceil(n / 4) of them, and the
+/// SAH prices it by that count.
+inline constexpr std::uint32_t kBvhLeafLaneGroup = 4;
 
 namespace detail {
 /// Storage aligned to `alignment` bytes; blocks of 4 MiB and more are aligned to 2 MiB and
@@ -105,6 +99,41 @@ struct AlignedAllocator {
 /// Wide nodes as a Bvh stores them: cache-line aligned, huge pages when large.
 template <int kWidth>
 using WideBvhNodes = std::vector<WideBvhNode<kWidth>, AlignedAllocator<WideBvhNode<kWidth>>>;
+
+/// The triangles of a Bvh's leaves as it stores them for TriangleSet<float> (see
+/// BvhConfig::triangle_blocks). A leaf of n triangles owns 4 ceil(n / 4) lanes from lane
+/// 4 first on (first: the leaf child's reference, see Bvh::binary_nodes), in groups of eight
+/// lanes while more than four are left, then one of four. A group of W lanes is the 10 W floats
+/// from lanes[10 l] (l: its first lane): nine rows of W, coordinate a of corner k of its lane j at
+/// (3 k + a) W + j as the set stores it, so that the group's lanes of one coordinate load at
+/// once (eight for one AVX2 step, four for SSE, as Embree's Triangle4 keeps four), then the W
+/// triangle indices (their bits, std::bit_cast to float). Lanes past n hold zeros and kNoIndex
+/// and are never tested. 40 bytes a lane.
+struct BvhLeafTriangles {
+    std::vector<float, AlignedAllocator<float>> lanes;
+
+    /// Lane `lane` of the leaf (first, count): where its group starts in `lanes`, the group's
+    /// width and the lane's place in it.
+    struct Place {
+        std::size_t group;
+        std::size_t width;
+        std::size_t lane;
+    };
+    static Place place(std::uint32_t first, std::uint32_t count, std::uint32_t lane) {
+        const std::uint32_t start = lane / 8 * 8;
+        return {10 * (4 * std::size_t{first} + start), count - start > 4 ? 8u : 4u,
+                std::size_t{lane - start}};
+    }
+    float corner(const Place& at, int k, int axis) const {
+        return lanes[at.group + std::size_t(3 * k + axis) * at.width + at.lane];
+    }
+    std::uint32_t primitive(const Place& at) const {
+        return std::bit_cast<std::uint32_t>(lanes[at.group + 9 * at.width + at.lane]);
+    }
+
+    bool empty() const { return lanes.empty(); }
+    std::size_t bytes() const { return lanes.capacity() * sizeof(float); }
+};
 
 namespace detail {
 
