@@ -99,24 +99,23 @@ private:
         node.end = end;
         node.common.lower = Point3::Constant(-kInfinity);
         node.common.upper = Point3::Constant(kInfinity);
-        double low[6], high[6];
-        std::fill(low, low + 6, kInfinity);
-        std::fill(high, high + 6, -kInfinity);
         for (std::size_t i = begin; i < end; ++i) {
             const Aabb& box = members_[i].box;
             node.all.extend(box);
             node.common.lower = node.common.lower.cwiseMax(box.lower);
             node.common.upper = node.common.upper.cwiseMin(box.upper);
             node.leaves = saturating_add(node.leaves, members_[i].leaves);
-            for (int k = 0; k < 6; ++k) {
-                low[k] = std::min(low[k], coordinate(box, k));
-                high[k] = std::max(high[k], coordinate(box, k));
-            }
         }
         if (end - begin > kLeafMembers) {
+            // The lower corners range from the union's lower corner to the common part's, the
+            // upper ones from the common part's upper corner to the union's.
+            const auto spread = [&node](int k) {
+                return k < 3 ? node.common.lower[k] - node.all.lower[k]
+                             : node.all.upper[k - 3] - node.common.upper[k - 3];
+            };
             int split = 0;
             for (int k = 1; k < 6; ++k) {
-                if (high[k] - low[k] > high[split] - low[split]) split = k;
+                if (spread(k) > spread(split)) split = k;
             }
             const std::size_t middle = begin + (end - begin) / 2;
             std::nth_element(members_.begin() + static_cast<std::ptrdiff_t>(begin),
