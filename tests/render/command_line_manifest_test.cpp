@@ -17,7 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "csgrt/render/command_line.h"
+#include "render/command_line_run.h"
+#include "support/test_output.h"
 
 namespace csgrt {
 namespace {
@@ -25,9 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(CommandLineManifest, EveryObjectIsNamedAsTheSceneFileNamesIt) {
-    const fs::path directory = fs::path(CSGRT_BINARY_DIR) / "test_output" / "cli_manifest";
-    fs::remove_all(directory);
-    fs::create_directories(directory);
+    const fs::path directory = test::fresh_directory("cli_manifest");
     // 3,000 objects side by side: unnamed ones (the manifest says "object N"), names of 300 to
     // 304 bytes sharing 300 (the string table then stores the shared length in two bytes),
     // one name used by many objects, short names, two shapes and three materials; the most
@@ -60,14 +59,9 @@ TEST(CommandLineManifest, EveryObjectIsNamedAsTheSceneFileNamesIt) {
     const fs::path scene = directory / "many.json";
     std::ofstream(scene) << text.str();
     const fs::path output = directory / "many.exr";
-    const std::vector<std::string> arguments = {
-        "csgrt", "render", scene.string(), "-o", output.string(), "--width", "4", "--height", "3"};
-    std::vector<const char*> argv;
-    for (const std::string& argument : arguments) argv.push_back(argument.c_str());
-    std::ostringstream out, err;
-    ASSERT_EQ(run_csgrt(static_cast<int>(argv.size()), argv.data(), CommandLineStreams{out, err}),
-              0)
-        << err.str();
+    const test::ProgramRun run = test::run_program(
+        {"render", scene.string(), "-o", output.string(), "--width", "4", "--height", "3"});
+    ASSERT_EQ(run.status, 0) << run.err;
 
     Imf::MultiPartInputFile parts(output.c_str());
     ASSERT_EQ(parts.parts(), 2);
