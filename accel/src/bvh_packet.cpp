@@ -328,7 +328,8 @@ struct BvhTraversal<Set>::Packets {
                         t_max = largest_t_max();
                         return false;
                     };
-                    walk_wide<false, false>(bvh, bvh.nodes_8_, test, largest_t_max(), unused, leaf);
+                    walk_wide<false, false, !kAny>(bvh, bvh.nodes_8_, test, largest_t_max(), unused,
+                                                   leaf);
                     return;
                 }
             }
@@ -338,7 +339,7 @@ struct BvhTraversal<Set>::Packets {
             t_max = largest_t_max();
             return open == 0;
         };
-        walk_wide<false, false>(bvh, bvh.nodes_8_, test, largest_t_max(), unused, leaf);
+        walk_wide<false, false, !kAny>(bvh, bvh.nodes_8_, test, largest_t_max(), unused, leaf);
     }
 #endif
 

@@ -5,6 +5,7 @@
 // Private to accel/src/bvh*.
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstddef>
@@ -370,12 +371,22 @@ struct alignas(32) Avx2FusedNodeTest {
             lowest = std::bit_cast<float>(std::bit_cast<std::uint32_t>(lowest) - 1u);
         t_min = _mm256_set1_ps(lowest);
         // Rows 2 axis (lower) and 2 axis + 1 (upper) of 32 bytes; a negative component makes
-        // the upper plane the near one.
-        const std::ptrdiff_t negative = _mm_movemask_ps(direction);
+        // the upper plane the near one. One table row for each of the eight sign patterns.
+        static constexpr auto kRows = [] {
+            std::array<std::array<std::ptrdiff_t, 6>, 8> rows{};
+            for (int signs = 0; signs < 8; ++signs) {
+                for (int axis = 0; axis < 3; ++axis) {
+                    const std::ptrdiff_t flip = ((signs >> axis) & 1) * 32;
+                    rows[signs][axis] = 64 * axis + flip;
+                    rows[signs][3 + axis] = 64 * axis + 32 - flip;
+                }
+            }
+            return rows;
+        }();
+        const auto& rows = kRows[_mm_movemask_ps(direction) & 7];
         for (int axis = 0; axis < 3; ++axis) {
-            const std::ptrdiff_t flip = ((negative >> axis) & 1) * 32;
-            near_row[axis] = 64 * axis + flip;
-            far_row[axis] = 64 * axis + 32 - flip;
+            near_row[axis] = rows[axis];
+            far_row[axis] = rows[3 + axis];
         }
         const __m256 r8 = _mm256_castps128_ps256(r), origin_r8 = _mm256_castps128_ps256(origin_r);
         reciprocal[0] = _mm256_permutevar8x32_ps(r8, _mm256_set1_epi32(0));

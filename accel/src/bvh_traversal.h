@@ -42,7 +42,7 @@ struct BvhTraversal {
     /// called as leaf(first, count, t_max) with the leaf's reference (see Bvh::binary_nodes)
     /// and the float upper bound of the interval, which it may lower; it returns true to stop.
     /// kAvx2: the 8-wide tree with the AVX2 node tests (run_avx2 and run_avx512 only).
-    template <bool kCount, bool kAvx2, class Leaf>
+    template <bool kCount, bool kAvx2, bool kNearestFirst = true, class Leaf>
     static bool traverse(const Tree& bvh, const Ray& ray, TraversalCounters& counters, Leaf& leaf) {
 #if CSGRT_BVH_AVX2
         if constexpr (kAvx2) {
@@ -53,8 +53,8 @@ struct BvhTraversal {
             switch (fused.make(ray)) {
                 case Avx2FusedNodeTest::Setup::kTaken:
                     if (!bvh.nodes_8_.empty()) {
-                        walk_wide<kCount, false>(bvh, bvh.nodes_8_, fused, round_up(ray.t_max),
-                                                 counters, leaf);
+                        walk_wide<kCount, false, kNearestFirst>(
+                            bvh, bvh.nodes_8_, fused, round_up(ray.t_max), counters, leaf);
                     }
                     return true;
                 case Avx2FusedNodeTest::Setup::kInvalid:
@@ -64,8 +64,8 @@ struct BvhTraversal {
             }
             const BoxRay box_ray(ray);
             if (!box_ray.valid) return false;
-            traverse_wide<kCount, true, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray, ray.t_max,
-                                                      counters, leaf);
+            traverse_wide<kCount, true, kNearestFirst, Avx2NodeTest>(bvh, bvh.nodes_8_, box_ray,
+                                                                     ray.t_max, counters, leaf);
             return true;
         }
 #endif
@@ -73,19 +73,19 @@ struct BvhTraversal {
         if (!box_ray.valid) return false;
         if (bvh.config_.width == 8) {
             if (box_ray.signed_interval) {
-                traverse_wide<kCount, true, SseNodeTest<8>>(bvh, bvh.nodes_8_, box_ray, ray.t_max,
-                                                            counters, leaf);
+                traverse_wide<kCount, true, kNearestFirst, SseNodeTest<8>>(
+                    bvh, bvh.nodes_8_, box_ray, ray.t_max, counters, leaf);
             } else {
-                traverse_wide<kCount, false, SseNodeTest<8>>(bvh, bvh.nodes_8_, box_ray, ray.t_max,
-                                                             counters, leaf);
+                traverse_wide<kCount, false, kNearestFirst, SseNodeTest<8>>(
+                    bvh, bvh.nodes_8_, box_ray, ray.t_max, counters, leaf);
             }
         } else if (bvh.config_.width == 4) {
             if (box_ray.signed_interval) {
-                traverse_wide<kCount, true, SseNodeTest<4>>(bvh, bvh.nodes_4_, box_ray, ray.t_max,
-                                                            counters, leaf);
+                traverse_wide<kCount, true, kNearestFirst, SseNodeTest<4>>(
+                    bvh, bvh.nodes_4_, box_ray, ray.t_max, counters, leaf);
             } else {
-                traverse_wide<kCount, false, SseNodeTest<4>>(bvh, bvh.nodes_4_, box_ray, ray.t_max,
-                                                             counters, leaf);
+                traverse_wide<kCount, false, kNearestFirst, SseNodeTest<4>>(
+                    bvh, bvh.nodes_4_, box_ray, ray.t_max, counters, leaf);
             }
         } else if (box_ray.signed_interval) {
             traverse_binary<kCount, true>(bvh, box_ray, ray.t_max, counters, leaf);
@@ -206,18 +206,20 @@ struct BvhTraversal {
         }
     }
 
-    template <bool kCount, bool kSigned, class NodeTest, int kWidth, class Leaf>
+    template <bool kCount, bool kSigned, bool kNearestFirst, class NodeTest, int kWidth, class Leaf>
     static void traverse_wide(const Tree& bvh, const WideBvhNodes<kWidth>& nodes,
                               const BoxRay& box_ray, double ray_t_max, TraversalCounters& counters,
                               Leaf& leaf) {
         if (nodes.empty()) return;
         const NodeTest test(box_ray);
-        walk_wide<kCount, kSigned>(bvh, nodes, test, round_up(ray_t_max), counters, leaf);
+        walk_wide<kCount, kSigned, kNearestFirst>(bvh, nodes, test, round_up(ray_t_max), counters,
+                                                  leaf);
     }
 
     /// traverse_wide with its node test made: `test.hit<kSigned>(node, t_max, t_enter)` gives
     /// the mask of the children to enter (a single ray's, or a packet's conservative one).
-    template <bool kCount, bool kSigned, class NodeTest, int kWidth, class Leaf>
+    template <bool kCount, bool kSigned, bool kNearestFirst = true, class NodeTest, int kWidth,
+              class Leaf>
     static void walk_wide(const Tree& bvh, const WideBvhNodes<kWidth>& nodes, const NodeTest& test,
                           float t_max, TraversalCounters& counters, Leaf& leaf) {
         using Node = WideBvhNode<kWidth>;
@@ -262,6 +264,16 @@ struct BvhTraversal {
                         *top++ = WideEntry{node.first[other], node.count[other], t_enter[other]};
                     }
                     prefetch(bvh, nodes, (top - 1)->first, (top - 1)->count);
+                    continue;
+                }
+                if constexpr (!kNearestFirst) {
+                    // Any hit will do (occlusion, every hit): the others wait in slot order.
+                    do {
+                        const int slot = std::countr_zero(mask);
+                        mask &= mask - 1;
+                        *top++ = WideEntry{node.first[slot], node.count[slot], t_enter[slot]};
+                        prefetch(bvh, nodes, node.first[slot], node.count[slot]);
+                    } while (mask != 0);
                     continue;
                 }
                 // Three or more children: push them all, then order the pushed entries so that
@@ -520,7 +532,7 @@ struct BvhTraversal {
         auto leaf = [&](std::uint32_t first, std::uint32_t count, float&) {
             return occluded = occluded_in_leaf<kCount>(bvh, leaf_ray, first, count, counters);
         };
-        traverse<kCount, kAvx2>(bvh, ray, counters, leaf);
+        traverse<kCount, kAvx2, false>(bvh, ray, counters, leaf);
         return occluded;
     }
 
@@ -541,7 +553,7 @@ struct BvhTraversal {
                                             return false;
                                         });
         };
-        traverse<kCount, kAvx2>(bvh, ray, counters, leaf);
+        traverse<kCount, kAvx2, false>(bvh, ray, counters, leaf);
     }
 
     /// The packet queries (bvh_packet.cpp): a member, so that they share the traversal's
