@@ -14,7 +14,10 @@ namespace csgrt::detail {
 /// The rays of a block taken Bvh::kPacketRays at a time through the BVH's packet queries
 /// (which answer as the single-ray queries do, bit for bit, and walk rays with one origin,
 /// camera rays, as one), or one at a time through any other structure. A packet is traced
-/// when one of its rays is first asked for.
+/// when one of its rays is first asked for. Only rays with one origin go through the packet
+/// query: for others (shadow rays from a surface, incoherent rays) it goes ray by ray anyway,
+/// after setting up every lane, and the batch's shadow rays on the armadillo cost 1,545
+/// instructions a ray that way against 1,360 through the single-ray query (callgrind).
 class RayPacket {
 public:
     template <class Real, class SetReal>
@@ -24,7 +27,7 @@ public:
                              QueryScratch& scratch) {
         if (!holds(i)) {
             start(rays, i, end);
-            if (bvh != nullptr) {
+            if (bvh != nullptr && one_origin_) {
                 bvh->intersect_packets({rays_, size_}, {records_, size_}, {hit_, size_}, scratch);
             } else {
                 for (std::size_t k = 0; k < size_; ++k)
@@ -39,7 +42,7 @@ public:
                   std::size_t i, std::size_t end, QueryScratch& scratch) {
         if (!holds(i)) {
             start(rays, i, end);
-            if (bvh != nullptr) {
+            if (bvh != nullptr && one_origin_) {
                 bvh->occluded_packets({rays_, size_}, {hit_, size_}, scratch);
             } else {
                 for (std::size_t k = 0; k < size_; ++k)
@@ -61,11 +64,15 @@ private:
         first_ = i;
         size_ = std::min(kRays - i % kRays, end - i);
         for (std::size_t k = 0; k < size_; ++k) rays_[k] = rays.ray(i + k);
+        one_origin_ = size_ > 1;
+        for (std::size_t k = 1; k < size_ && one_origin_; ++k)
+            one_origin_ = rays_[k].origin == rays_[0].origin;
     }
 
     Ray rays_[kRays];
     HitRecord records_[kRays];
     bool hit_[kRays] = {};
+    bool one_origin_ = false;
     std::size_t first_ = static_cast<std::size_t>(-1), size_ = 0;
 };
 
