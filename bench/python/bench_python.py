@@ -19,6 +19,7 @@ import os
 import pathlib
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -100,6 +101,21 @@ def time_csgrt(vertices, triangles, rays, repetitions, threads_list):
     return rows, float(hits)
 
 
+def time_cpp_batch(timer, vertices, triangles, rays, repetitions, threads_list):
+    """The C++ batch on the same mesh and rays (bench/batch_timer_main.cpp), for the ratio of
+    Python's cast_rays to it."""
+    with tempfile.TemporaryDirectory() as folder:
+        folder = pathlib.Path(folder)
+        vertices.astype(np.float32).tofile(folder / "vertices")
+        triangles.astype(np.uint32).tofile(folder / "triangles")
+        np.ascontiguousarray(rays, dtype=np.float32).tofile(folder / "rays")
+        result = subprocess.run([str(timer), str(folder / "vertices"), str(folder / "triangles"),
+                                 str(folder / "rays"), "--repetitions", str(repetitions),
+                                 "--threads", ",".join(str(t) for t in threads_list)],
+                                check=True, capture_output=True, text=True)
+    return json.loads(result.stdout)
+
+
 def time_peers(vertices, triangles, rays, repetitions, threads_list):
     rows = []
     try:
@@ -158,6 +174,8 @@ def main():
     parser.add_argument("--make-venv", action="store_true")
     parser.add_argument("--peers-only", action="store_true")
     parser.add_argument("--json")
+    parser.add_argument("--batch-timer",
+                        help="csgrt_batch_timer (default: bench/ beside the csgrt module's build)")
     args = parser.parse_args()
 
     vertices, triangles = read_off(args.mesh)
@@ -171,6 +189,15 @@ def main():
     if args.make_venv:
         make_venv(venv)
     rows, hit_fraction = time_csgrt(vertices, triangles, rays, args.repetitions, threads_list)
+    import csgrt
+
+    timer = pathlib.Path(args.batch_timer or
+                         pathlib.Path(csgrt.__file__).resolve().parents[1] / "bench" /
+                         "csgrt_batch_timer")
+    if timer.exists():
+        rows += time_cpp_batch(timer, vertices, triangles, rays, args.repetitions, threads_list)
+    else:
+        print(f"bench_python: no {timer}: the C++ batch is not measured", file=sys.stderr)
     if (venv / "bin" / "python").exists():
         result = subprocess.run([str(venv / "bin" / "python"), __file__, "--peers-only",
                                  "--mesh", args.mesh, "--rays", str(args.rays),
@@ -197,6 +224,30 @@ def main():
         rate = r["mrays_per_cpu_second"] if r["threads"] == 1 else r["mrays_per_second"]
         print(f"{r['variant']:58} {r['threads']:>7} {rate:9.2f}   "
               f"{n / r['max']:6.2f}-{n / r['min']:<6.2f}  {n / r['cpu_seconds']:.2f}")
+    # The ratios the issue's floors name, each from two figures of this run, in wall time
+    # (median, and min-max: the slowest over the fastest repetition and the fastest over the
+    # slowest), so the spread is that of the ratio itself.
+    def rate(r, pick):
+        seconds = {"median": r["seconds"], "fast": r["min"], "slow": r["max"]}[pick]
+        return len(rays) / seconds
+
+    def find(prefix, threads):
+        return next((r for r in rows if r["variant"].startswith(prefix) and
+                     r["threads"] == threads), None)
+
+    print(f"\n{'ratio (wall time)':58} {'threads':>7} {'median':>9}   {'min-max':>14}")
+    for threads in threads_list:
+        for label, mine, peer in [
+                ("Python cast_rays / C++ batch (all outputs)", "csgrt cast_rays (all",
+                 "C++ batch intersect (all"),
+                ("Python cast_rays / C++ batch (t, id)", "csgrt cast_rays (t", "C++ batch intersect (t"),
+                ("csgrt cast_rays (all outputs) / Open3D cast_rays", "csgrt cast_rays (all",
+                 "open3d")]:
+            a, b = find(mine, threads), find(peer, threads)
+            if a is None or b is None:
+                continue
+            print(f"{label:58} {threads:>7} {rate(a, 'median') / rate(b, 'median'):9.2f}   "
+                  f"{rate(a, 'slow') / rate(b, 'fast'):6.2f}-{rate(a, 'fast') / rate(b, 'slow'):<6.2f}")
     if args.json:
         pathlib.Path(args.json).write_text(json.dumps(
             {"rays": len(rays), "triangles": len(triangles), "load_average": load,
