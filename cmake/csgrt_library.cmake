@@ -27,10 +27,20 @@ function(csgrt_library_conventions target component)
         PRIVATE $<BUILD_INTERFACE:csgrt_warnings> $<BUILD_INTERFACE:csgrt_exact_fp>)
     # The public headers are C++20; a consumer's compiler is told so by the target.
     target_compile_features(${target} PUBLIC cxx_std_20)
+    # Position-independent always: the Python module (a shared object) links the static
+    # libraries, and the static and shared builds then compile every source alike, so the
+    # install test's shared build reuses the objects through ccache. -fno-semantic-interposition
+    # keeps -fPIC from blocking inlining of a library's calls to its own functions. No
+    # <target>_EXPORTS define: exports are the version script's (cmake/csgrt.map).
     set_target_properties(${target} PROPERTIES
         EXPORT_NAME ${component}
         VERSION ${PROJECT_VERSION}
-        SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
+        SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR}
+        POSITION_INDEPENDENT_CODE ON
+        DEFINE_SYMBOL "")
+    if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+        target_compile_options(${target} PRIVATE -fno-semantic-interposition)
+    endif()
     get_target_property(type ${target} TYPE)
     if(type STREQUAL "SHARED_LIBRARY")
         # --no-undefined: a shared library that forgot a dependency fails to link here, not

@@ -178,6 +178,12 @@ if(CSGRT_BUILD_TESTS AND NOT CSGRT_SANITIZE AND NOT CSGRT_TSAN AND NOT CSGRT_FUZ
         -D GENERATOR=${CMAKE_GENERATOR}
         -D CXX_COMPILER=${CMAKE_CXX_COMPILER}
         -D BUILD_TYPE=${CMAKE_BUILD_TYPE})
+    # The shared build compiles as this one does when a launcher (ccache) can reuse its objects.
+    string(TOUPPER "${CMAKE_BUILD_TYPE}" csgrt_build_type_upper)
+    set(CSGRT_SHARED_TEST_ARGUMENTS
+        "-D LAUNCHER=${CMAKE_CXX_COMPILER_LAUNCHER}" "-D CXX_FLAGS=${CMAKE_CXX_FLAGS}"
+        "-D CXX_FLAGS_CONFIG=${CMAKE_CXX_FLAGS_${csgrt_build_type_upper}}"
+        -D NATIVE=${CSGRT_NATIVE})
     add_test(NAME install.consumer_project
         COMMAND ${CMAKE_COMMAND} ${CSGRT_INSTALL_TEST_ARGUMENTS}
             -D BUILD_DIR=${PROJECT_BINARY_DIR}
@@ -185,7 +191,7 @@ if(CSGRT_BUILD_TESTS AND NOT CSGRT_SANITIZE AND NOT CSGRT_TSAN AND NOT CSGRT_FUZ
             -P ${PROJECT_SOURCE_DIR}/tests/install/run_install_test.cmake)
     set_tests_properties(install.consumer_project PROPERTIES LABELS install TIMEOUT 600)
     add_test(NAME install.shared_libraries
-        COMMAND ${CMAKE_COMMAND} ${CSGRT_INSTALL_TEST_ARGUMENTS}
+        COMMAND ${CMAKE_COMMAND} ${CSGRT_INSTALL_TEST_ARGUMENTS} ${CSGRT_SHARED_TEST_ARGUMENTS}
             -D SOURCE_DIR=${PROJECT_SOURCE_DIR}
             -D BUILD_DIR=${PROJECT_BINARY_DIR}/install_test_shared/libraries
             -D WORK_DIR=${PROJECT_BINARY_DIR}/install_test_shared
