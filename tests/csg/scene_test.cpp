@@ -120,8 +120,10 @@ TEST(Scene, ObjectIdsNameTheObjectAndTiesGoToTheLowerIndex) {
     EXPECT_EQ(hit->object_id, 2u);
     EXPECT_DOUBLE_EQ(hit->t, 8.0);
     hit = scene.intersect(Ray{Point3(5, 10, 0), Vector3(0, -1, 0)}, scratch);
+    ASSERT_TRUE(hit);
     EXPECT_EQ(hit->object_id, 0u);
     hit = scene.intersect(Ray{Point3(50, 10, 0), Vector3(0, -1, 0)}, scratch);
+    ASSERT_TRUE(hit);
     EXPECT_EQ(hit->object_id, 1u);
     EXPECT_EQ(hit->shape, scene.objects()[1].shape.get());
     // From below, the ground (1) and sphere 2 touch at the origin: t = 1 for both, 1 wins.
