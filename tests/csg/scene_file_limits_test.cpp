@@ -186,12 +186,12 @@ TEST(SceneFileLimits, APileWrittenOutAmongManyObjectsIsFoundWhereverItIs) {
 }
 
 /// The box of sphere `centre`, `radius` as the test sees it.
-struct TestBox {
+struct SphereBox {
     Eigen::Vector3d lower, upper;
     bool contains(const Eigen::Vector3d& p) const {
         return (p.array() >= lower.array()).all() && (p.array() <= upper.array()).all();
     }
-    bool encloses(const TestBox& inner, double margin) const {
+    bool encloses(const SphereBox& inner, double margin) const {
         return (lower.array() <= inner.lower.array() - margin).all() &&
                (upper.array() >= inner.upper.array() + margin).all();
     }
@@ -220,7 +220,7 @@ TEST(SceneFileLimits, TheOverlapOfALongListIsTheDirectCountAtEveryCentre) {
         const double side = 4.0 + 1.0 * static_cast<double>(seed);
         std::uniform_real_distribution<double> position(0.0, side), log_size(-1.2, 1.8);
         std::string text = blob + R"("objects": [)";
-        std::vector<TestBox> boxes;
+        std::vector<SphereBox> boxes;
         for (int i = 0; i < kMembers; ++i) {
             const double scale = std::exp(log_size(random));
             const Eigen::Vector3d at(position(random), position(random), position(random));
@@ -237,11 +237,11 @@ TEST(SceneFileLimits, TheOverlapOfALongListIsTheDirectCountAtEveryCentre) {
         std::uint64_t worst = kLeaves;
         int worst_at = -1;
         for (int s = 0; s < kMembers; ++s) {
-            const TestBox& sample = boxes[s];
+            const SphereBox& sample = boxes[s];
             const Eigen::Vector3d centre = 0.5 * (sample.lower + sample.upper);
             const double margin = 0.01 * (sample.upper - sample.lower).norm();
             std::uint64_t leaves = 0;
-            for (const TestBox& other : boxes) {
+            for (const SphereBox& other : boxes) {
                 if (other.contains(centre) && !other.encloses(sample, margin) &&
                     !sample.encloses(other, margin)) {
                     leaves += kLeaves;
