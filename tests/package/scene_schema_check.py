@@ -47,6 +47,8 @@ BEYOND_THE_SCHEMA = {
     "array_transform_product_overflow.json": "a product of the transform steps",
     "grid_copy_transform_overflow.json": "a power of the copy transform",
     "material_ramp_glass_and_paint.json": "the index of refraction of the named materials",
+    "pile_hidden_between_samples.json": "how many objects' boxes overlap at one point",
+    "reference_cycle_long_names.json": "references between definitions",
 }
 
 
