@@ -287,31 +287,45 @@ void intersect(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& ra
     if (!outputs.material.empty()) {
         throw InvalidParameter("material: a triangle structure has no materials");
     }
-    const bool wants_normal = !outputs.geometric_normal.empty() || !outputs.shading_normal.empty();
     const bool wants_ids = !outputs.object_id.empty() || !outputs.primitive_id.empty();
+    const bool wants_normal = !outputs.geometric_normal.empty() || !outputs.shading_normal.empty();
     const auto* bvh = dynamic_cast<const Bvh<TriangleSet<SetReal>>*>(mesh.structure);
     for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        detail::RayPacket packet;
-        for (std::size_t i = begin; i < end; ++i) {
-            const HitRecord* found = packet.nearest(bvh, *mesh.structure, rays, i, end, s);
-            if (found == nullptr) {
-                write_miss(outputs, i);
-                continue;
+        detail::RayGroup group;
+        for (std::size_t i = begin; i < end; i += group.size) {
+            group.load(rays, i, end);
+            group.nearest(bvh, *mesh.structure, s);
+            const std::size_t n = group.size;
+            const HitRecord* records = group.records;
+            const bool* hit = group.hit;
+            if (!outputs.t.empty()) {
+                for (std::size_t k = 0; k < n; ++k) {
+                    outputs.t[i + k] = static_cast<Real>(hit[k] ? records[k].t : kInfinity);
+                }
             }
-            const HitRecord& record = *found;
-            write1(outputs.t, i, static_cast<Real>(record.t));
             if (wants_ids) {
-                std::uint32_t object, primitive;
-                triangle_ids(mesh, record.primitive, object, primitive);
-                write1(outputs.object_id, i, object);
-                write1(outputs.primitive_id, i, primitive);
+                for (std::size_t k = 0; k < n; ++k) {
+                    std::uint32_t object = kNoIndex, primitive = kNoIndex;
+                    if (hit[k]) triangle_ids(mesh, records[k].primitive, object, primitive);
+                    write1(outputs.object_id, i + k, object);
+                    write1(outputs.primitive_id, i + k, primitive);
+                }
             }
-            write2(outputs.uv, i, double(record.u), double(record.v));
+            if (!outputs.uv.empty()) {
+                for (std::size_t k = 0; k < n; ++k) {
+                    write2(outputs.uv, i + k, hit[k] ? double(records[k].u) : 0.0,
+                           hit[k] ? double(records[k].v) : 0.0);
+                }
+            }
             if (wants_normal) {
-                // Bare triangles have no vertex normals: shading is the geometric normal.
-                const Normal3 n = triangle_normal(*mesh.triangles, record.primitive);
-                write3(outputs.geometric_normal, i, n);
-                write3(outputs.shading_normal, i, n);
+                for (std::size_t k = 0; k < n; ++k) {
+                    // Bare triangles have no vertex normals: shading is the geometric normal.
+                    const Normal3 normal = hit[k]
+                                               ? triangle_normal(*mesh.triangles, records[k].primitive)
+                                               : Normal3::Zero();
+                    write3(outputs.geometric_normal, i + k, normal);
+                    write3(outputs.shading_normal, i + k, normal);
+                }
             }
         }
     });
@@ -336,9 +350,11 @@ void occluded(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& ray
     check_size(occluded.size(), rays.size(), "occluded");
     const auto* bvh = dynamic_cast<const Bvh<TriangleSet<SetReal>>*>(mesh.structure);
     for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        detail::RayPacket packet;
-        for (std::size_t i = begin; i < end; ++i) {
-            occluded[i] = packet.occluded(bvh, *mesh.structure, rays, i, end, s);
+        detail::RayGroup group;
+        for (std::size_t i = begin; i < end; i += group.size) {
+            group.load(rays, i, end);
+            group.occluded(bvh, *mesh.structure, s);
+            for (std::size_t k = 0; k < group.size; ++k) occluded[i + k] = group.hit[k];
         }
     });
 }

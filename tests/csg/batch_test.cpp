@@ -99,8 +99,16 @@ template <class Real>
 struct NearestHits {
     std::vector<Real> t, uv, geometric, shading;
     std::vector<std::uint32_t> object, primitive, material;
+    /// Filled with values no query writes (-7, id 7 is not the miss's kNoIndex either), so a
+    /// slot the batch left unwritten shows.
     explicit NearestHits(std::size_t n)
-        : t(n), uv(2 * n), geometric(3 * n), shading(3 * n), object(n), primitive(n), material(n) {}
+        : t(n, Real(-7)),
+          uv(2 * n, Real(-7)),
+          geometric(3 * n, Real(-7)),
+          shading(3 * n, Real(-7)),
+          object(n, 7u),
+          primitive(n, 7u),
+          material(n, 7u) {}
     NearestHitOutputs<Real> outputs() { return {t, object, primitive, uv, geometric, shading, {}}; }
     /// With the material, which only a scene has.
     NearestHitOutputs<Real> scene_outputs() {
@@ -301,8 +309,17 @@ TYPED_TEST(BatchTest, TriangleQueriesAgainstTheStructureBruteForceAndMembership)
         const Ray ray = buffer.arrays().ray(i);
         HitRecord record;
         if (!meshes.bvh->intersect(ray, record, scratch)) {
+            // A miss as the header defines it: every output written, t infinite, ids kNoIndex,
+            // uv and normals zero.
             ASSERT_EQ(all.t[i], std::numeric_limits<Real>::infinity());
             ASSERT_EQ(all.primitive[i], kNoIndex);
+            ASSERT_EQ(all.object[i], kNoIndex);
+            ASSERT_EQ(all.uv[2 * i], Real(0));
+            ASSERT_EQ(all.uv[2 * i + 1], Real(0));
+            for (int k = 0; k < 3; ++k) {
+                ASSERT_EQ(all.geometric[3 * i + k], Real(0));
+                ASSERT_EQ(all.shading[3 * i + k], Real(0));
+            }
             ASSERT_EQ(counts[i], 0u);
             continue;
         }
@@ -313,7 +330,11 @@ TYPED_TEST(BatchTest, TriangleQueriesAgainstTheStructureBruteForceAndMembership)
                   record.primitive - (on_cube ? std::uint32_t(meshes.sphere_triangles) : 0u));
         ASSERT_EQ(all.uv[2 * i + 1], static_cast<Real>(record.v));
         const Normal3 n_expected = triangle_normal(meshes.set, record.primitive);
-        ASSERT_EQ(all.geometric[3 * i + 2], static_cast<Real>(n_expected.z()));
+        for (int k = 0; k < 3; ++k) {
+            ASSERT_EQ(all.geometric[3 * i + k], static_cast<Real>(n_expected[k]));
+            ASSERT_EQ(all.shading[3 * i + k], static_cast<Real>(n_expected[k]));
+        }
+        ASSERT_EQ(all.uv[2 * i], static_cast<Real>(record.u));
         // Crossings against brute force's list of every hit (these random rays pass through no
         // shared edge, so every hit is a crossing).
         brute_hits.clear();
