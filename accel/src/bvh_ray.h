@@ -22,12 +22,14 @@
 // only on a CPU that has it.
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define CSGRT_BVH_AVX2 1
-/// The target of every AVX2 function of the BVH: AVX2 and FMA (build() checks the CPU for both).
-#define CSGRT_BVH_AVX2_TARGET "avx2,fma"
+/// The target of every AVX2 function of the BVH: AVX2 and FMA, and the bit instructions every
+/// AVX2 CPU also has (BMI1/2 and POPCNT: the walk's child masks take tzcnt and blsr rather
+/// than bsf with a zero test), which build() checks the CPU for with the others.
+#define CSGRT_BVH_AVX2_TARGET "avx2,fma,bmi,bmi2,popcnt"
 /// The AVX2 queries compiled once more with AVX-512 (F, VL, BW, DQ) allowed: the same intrinsics,
 /// so the same operations and bits, but 32 vector registers and mask registers to keep the ray's
 /// and the node's values in.
-#define CSGRT_BVH_AVX512_TARGET "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"
+#define CSGRT_BVH_AVX512_TARGET "avx2,fma,bmi,bmi2,popcnt,avx512f,avx512vl,avx512bw,avx512dq"
 #include <immintrin.h>
 #else
 #define CSGRT_BVH_AVX2 0
