@@ -15,19 +15,11 @@
 
 #include "csgrt/csg/compound.h"
 #include "csgrt/csg/scene_file.h"
+#include "support/scene_error.h"
 #include "support/test_scale.h"
 
 namespace csgrt {
 namespace {
-
-std::string error_of(const std::string& text) {
-    try {
-        load_scene_from_string(text, "test.json");
-    } catch (const SceneError& error) {
-        return error.what();
-    }
-    return "no error";
-}
 
 /// d0 is a unit sphere; d_k = compound [d_{k-1}, d_{k-1} moved along x by `offset`, times
 /// 2^(k-1) when `growing` (then no two copies share a place)].
@@ -84,17 +76,17 @@ TEST(SceneFileLimits, ExactlyCoincidentCopiesCostOneTest) {
 
 TEST(SceneFileLimits, APileOfNearlyCoincidentCopiesIsRefusedAtItsDefinition) {
     // 2^13 copies a nanometre apart load; d14 has 2^14 > 10,000 and is named.
-    EXPECT_EQ(error_of(doubling(13, 1e-9)), "no error");
-    const std::string message = error_of(doubling(20, 1e-9));
+    EXPECT_EQ(test::scene_error_of(doubling(13, 1e-9)), "no error");
+    const std::string message = test::scene_error_of(doubling(20, 1e-9));
     EXPECT_NE(message.find("test.json: /definitions/d14: about 16384 leaf shapes overlap at one "
                            "point"),
               std::string::npos)
         << message;
     // Moved by more than their size, the copies are no pile: 2^20 spheres side by side.
-    EXPECT_EQ(error_of(doubling(20, 2.5, true)), "no error");
+    EXPECT_EQ(test::scene_error_of(doubling(20, 2.5, true)), "no error");
     // But equal moves at every level pile C(k, j) copies at j * 2.5, C(16, 8) = 12870 at d16
     // (the estimate, which adds up overlapping children, says 2^14 there).
-    EXPECT_NE(error_of(doubling(20, 2.5)).find("/definitions/d16: about 16384 leaf shapes"),
+    EXPECT_NE(test::scene_error_of(doubling(20, 2.5)).find("/definitions/d16: about 16384 leaf shapes"),
               std::string::npos);
 }
 
@@ -105,16 +97,16 @@ TEST(SceneFileLimits, AGridPiledCloserThanItsItemIsRefusedAtItsCount) {
         return text.append(R"(], "item": {"type": "sphere", "radius": 1}}]})");
     };
     // Boxes 2 wide, 0.1 apart: floor(2 / 0.1) + 1 = 21 copies meet along each axis, 9261.
-    EXPECT_EQ(error_of(grid("0.1")), "no error");
+    EXPECT_EQ(test::scene_error_of(grid("0.1")), "no error");
     // 0.095 apart: 22 along each axis, 10648.
-    const std::string message = error_of(grid("0.095"));
+    const std::string message = test::scene_error_of(grid("0.095"));
     EXPECT_NE(message.find("test.json: /objects/0/count: 10648 copies meet at one point"),
               std::string::npos)
         << message;
     // Spacing 0 makes exact repeats, which cost one test.
-    EXPECT_EQ(error_of(grid("0")), "no error");
+    EXPECT_EQ(test::scene_error_of(grid("0")), "no error");
     // An item that can never be hit (its box is empty) piles up nothing.
-    EXPECT_EQ(error_of(R"({"objects": [{"type": "grid", "count": [30, 30, 30], "spacing": )"
+    EXPECT_EQ(test::scene_error_of(R"({"objects": [{"type": "grid", "count": [30, 30, 30], "spacing": )"
                        R"([1e-9, 1e-9, 1e-9], "item": {"type": "intersection", "operands": [)"
                        R"({"type": "sphere", "radius": 1}, {"type": "sphere", "center": )"
                        R"([5, 0, 0], "radius": 1}]}}]})"),
@@ -152,12 +144,12 @@ TEST(SceneFileLimits, TheOverlapEstimateTracksTheWorkOfARay) {
     ASSERT_TRUE(onion.intersect_counted(into_the_onion, scratch, onion_work).has_value());
     EXPECT_LT(onion_work.primitives_tested, 64u);
     // 10,001 in a pile are refused, naming an object; the shells are not a pile.
-    const std::string message = error_of(spheres(10'001, 1e-9, false));
+    const std::string message = test::scene_error_of(spheres(10'001, 1e-9, false));
     EXPECT_NE(message.find("with the objects around it, about 10001 leaf shapes overlap"),
               std::string::npos)
         << message;
     EXPECT_NE(message.find("test.json: /objects/"), std::string::npos) << message;
-    EXPECT_EQ(error_of(spheres(12'000, 0.0, true)), "no error");
+    EXPECT_EQ(test::scene_error_of(spheres(12'000, 0.0, true)), "no error");
 }
 
 TEST(SceneFileLimits, APileWrittenOutAmongManyObjectsIsFoundWhereverItIs) {
@@ -178,7 +170,7 @@ TEST(SceneFileLimits, APileWrittenOutAmongManyObjectsIsFoundWhereverItIs) {
         text += object;
     }
     text += "]}";
-    const std::string message = error_of(text);
+    const std::string message = test::scene_error_of(text);
     EXPECT_NE(message.find("test.json: /objects/1: with the objects around it, about 10001 leaf "
                            "shapes overlap"),
               std::string::npos)
@@ -252,7 +244,7 @@ TEST(SceneFileLimits, TheOverlapOfALongListIsTheDirectCountAtEveryCentre) {
                 worst_at = s;
             }
         }
-        const std::string message = error_of(text);
+        const std::string message = test::scene_error_of(text);
         if (worst <= 10'000) {
             EXPECT_EQ(message, "no error") << "seed " << seed << ", direct count " << worst;
             continue;
@@ -276,7 +268,7 @@ TEST(SceneFileLimits, AnErrorDeepDownNamesItsPlaceThroughEveryLevel) {
     text += R"({"type": "sphere", "radius": -1})";
     for (int i = 0; i < 255; ++i) text += R"(, {"type": "sphere", "radius": 1}]})";
     text += "]}";
-    const std::string message = error_of(text);
+    const std::string message = test::scene_error_of(text);
     EXPECT_EQ(message.rfind("test.json: /objects/0/operands/0/operands/0/", 0), 0u) << message;
     // "/objects/0", 255 steps "/operands/0" of 11 characters, "/radius": 2822 characters.
     // The first 120 end where step 11 starts, the last 120 begin inside step 245, so steps 11
@@ -300,7 +292,7 @@ TEST(SceneFileLimitsHeavy, MoreThanTwoToTheTwentyFiveJsonValuesAreRefusedWhereTh
     text.reserve(2 * kZeros + 16);
     for (std::size_t i = 0; i < kZeros; ++i) text.append(i ? ",0" : "0");
     text += "]}";
-    const std::string message = error_of(text);
+    const std::string message = test::scene_error_of(text);
     EXPECT_EQ(message, "test.json: /objects/33554430: more than 33554432 JSON values (numbers, "
                        "strings, arrays and objects; docs/scene-format.md, Limits)");
 }

@@ -15,6 +15,7 @@
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/compound.h"
 #include "support/random.h"
+#include "support/scene_error.h"
 
 namespace csgrt {
 namespace {
@@ -24,15 +25,6 @@ namespace fs = std::filesystem;
 const fs::path kScenes = fs::path(CSGRT_SOURCE_DIR) / "data" / "scenes";
 const fs::path kMeshes = fs::path(CSGRT_SOURCE_DIR) / "tests" / "data" / "meshes";
 const fs::path kBroken = fs::path(CSGRT_SOURCE_DIR) / "tests" / "data" / "scenes" / "broken";
-
-std::string error_of(std::string_view text) {
-    try {
-        load_scene_from_string(text, "test.json");
-    } catch (const SceneError& error) {
-        return error.what();
-    }
-    return "no error";
-}
 
 Scene load(std::string_view text) {
     return load_scene_from_string(text, "test.json");
@@ -389,11 +381,11 @@ TEST(SceneFile, MutatedScenesLoadOrGiveASceneError) {
 }
 
 TEST(SceneFile, MessagesForStringsNameTheGivenName) {
-    const std::string message = error_of(R"({"objects": [{"type": "sphere"}]})");
+    const std::string message = test::scene_error_of(R"({"objects": [{"type": "sphere"}]})");
     EXPECT_EQ(message.rfind("test.json: /objects/0: missing required key", 0), 0u) << message;
     // Keys with '/' and '~' are escaped in pointers (RFC 6901).
     const std::string escaped =
-        error_of(R"({"definitions": {"a/b~c": {"type": "sphere"}}, "objects": []})");
+        test::scene_error_of(R"({"definitions": {"a/b~c": {"type": "sphere"}}, "objects": []})");
     EXPECT_NE(escaped.find("/definitions/a~1b~0c"), std::string::npos) << escaped;
 }
 
@@ -408,7 +400,7 @@ std::string nested_unions(std::size_t levels) {
 
 TEST(SceneFile, HundredThousandNestedLevelsGiveAnErrorNamingThePointer) {
     // 200,002 JSON levels: the parser stops at the 1000th (a union object at an even depth).
-    const std::string message = error_of(nested_unions(100'000));
+    const std::string message = test::scene_error_of(nested_unions(100'000));
     EXPECT_NE(message.find("nesting deeper than 1000 arrays and objects"), std::string::npos)
         << message.substr(0, 300);
     // The innermost open container, the 1000th, is the operands array of union 498 (from 0);
@@ -421,12 +413,12 @@ TEST(SceneFile, HundredThousandNestedLevelsGiveAnErrorNamingThePointer) {
     EXPECT_LT(message.size(), 500u);
     // Within the JSON limit, the shapes' own limit: 300 unions nest 301 shapes; union 256 is
     // the first one too deep.
-    const std::string shapes = error_of(nested_unions(300));
+    const std::string shapes = test::scene_error_of(nested_unions(300));
     EXPECT_NE(shapes.find("/operands/0/operands/0: shapes nested deeper than 256 levels"),
               std::string::npos)
         << shapes.substr(0, 400);
     // 400 unions fail at the same union 256: the limit is met on the way down.
-    EXPECT_EQ(error_of(nested_unions(300)), error_of(nested_unions(400)));
+    EXPECT_EQ(test::scene_error_of(nested_unions(300)), test::scene_error_of(nested_unions(400)));
     // 255 unions and the sphere: 256 levels, allowed.
     EXPECT_EQ(load(nested_unions(255)).objects().size(), 1u);
 }
@@ -440,7 +432,7 @@ TEST(SceneFile, AChainOfHundredThousandRefsIsCutAtTheShapeDepthLimit) {
         text.append("\"}, ");
     }
     text += R"("d100000": {"type": "sphere", "radius": 1}}, "objects": []})";
-    const std::string message = error_of(text);
+    const std::string message = test::scene_error_of(text);
     EXPECT_NE(message.find("shapes nested deeper than 256 levels"), std::string::npos)
         << message.substr(0, 300);
     EXPECT_NE(message.find("test.json: /definitions/d256: "), std::string::npos)
@@ -467,13 +459,13 @@ TEST(SceneFile, ExpandedLeavesAreCountedOnceEachAndCapped) {
     // 2^64 leaves in 8 KB: refused at the object that passes 10^7, with the saturated count.
     const std::string text = doubling_definitions(64, 64);
     ASSERT_LT(text.size(), 8000u);
-    const std::string message = error_of(text);
+    const std::string message = test::scene_error_of(text);
     EXPECT_NE(message.find("test.json: /objects/0: the scene expands to at least 2^64 - 1 leaf "
                            "shapes"),
               std::string::npos)
         << message;
     // 2^23 = 8,388,608 leaves is within the limit; 2^24 is not.
-    EXPECT_NE(error_of(doubling_definitions(24, 24)).find("expands to 16777216 leaf shapes"),
+    EXPECT_NE(test::scene_error_of(doubling_definitions(24, 24)).find("expands to 16777216 leaf shapes"),
               std::string::npos);
     // The count info reports, against the closed form: 2^20 spheres under 2^20 - 1 compounds.
     const Scene scene = load(doubling_definitions(20, 20));
@@ -487,10 +479,10 @@ TEST(SceneFile, ExpandedLeavesAreCountedOnceEachAndCapped) {
 TEST(SceneFile, NamesFromTheFileAreEscapedAndCutInMessages) {
     const std::string long_key(10'000, 'k');
     const std::string message =
-        error_of(R"({"objects": [{"type": "sphere", "radius": 1, ")" + long_key + R"(": 2}]})");
+        test::scene_error_of(R"({"objects": [{"type": "sphere", "radius": 1, ")" + long_key + R"(": 2}]})");
     EXPECT_LT(message.size(), 600u) << message.size();
     EXPECT_NE(message.find("... (10000 bytes)"), std::string::npos) << message;
-    const std::string control = error_of("{\"objects\": [{\"type\": \"s\\u001b[2Jphere\"}]}");
+    const std::string control = test::scene_error_of("{\"objects\": [{\"type\": \"s\\u001b[2Jphere\"}]}");
     for (const char c : control) EXPECT_GE(static_cast<unsigned char>(c), 0x20u) << control;
     EXPECT_NE(control.find("unknown shape type \"s\\u001b[2Jphere\""), std::string::npos)
         << control;

@@ -9,18 +9,10 @@
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/compound.h"
 #include "csgrt/csg/scene_file.h"
+#include "support/scene_error.h"
 
 namespace csgrt {
 namespace {
-
-std::string error_of(const std::string& text) {
-    try {
-        load_scene_from_string(text, "test.json");
-    } catch (const SceneError& error) {
-        return error.what();
-    }
-    return "no error";
-}
 
 /// A grid of 10^3 copies of a legal grid of 10^6 spheres (10^9 leaves).
 const std::string kNestedGrids =
@@ -29,7 +21,7 @@ const std::string kNestedGrids =
     R"( "radius": 0.004}}})";
 
 TEST(SceneLeafPrescan, NestedGridsAreRefusedAtTheOuterCountWithTheProduct) {
-    const std::string message = error_of(R"({"objects": [)" + kNestedGrids + "]}");
+    const std::string message = test::scene_error_of(R"({"objects": [)" + kNestedGrids + "]}");
     EXPECT_NE(message.find("test.json: /objects/0/count: 1000 copies of an item of 1000000 leaf "
                            "shapes are more than the 10000000 leaves"),
               std::string::npos)
@@ -41,7 +33,7 @@ TEST(SceneLeafPrescan, TheCountComesBeforeAnythingIsBuilt) {
     // is reported first: the count ran on the parsed JSON before object 0 was built, so the
     // inner 10^6-sphere grid of object 1 was never built either.
     const std::string message =
-        error_of(R"({"objects": [{"type": "sphere", "radius": -1}, )" + kNestedGrids + "]}");
+        test::scene_error_of(R"({"objects": [{"type": "sphere", "radius": -1}, )" + kNestedGrids + "]}");
     EXPECT_NE(message.find("test.json: /objects/1/count: 1000 copies"), std::string::npos)
         << message;
 }
@@ -55,7 +47,7 @@ TEST(SceneLeafPrescan, GridsInsideDefinitionsAndListsAreCountedPerUse) {
     for (int i = 0; i < 11; ++i)
         text += std::string(i ? ", " : "") + R"({"type": "ref", "definition": "d"})";
     text += "]}]}";
-    const std::string message = error_of(text);
+    const std::string message = test::scene_error_of(text);
     EXPECT_NE(message.find("test.json: /objects/0: the scene expands to 11000000 leaf shapes"),
               std::string::npos)
         << message;
