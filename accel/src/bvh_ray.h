@@ -221,6 +221,8 @@ template <int kWidth>
 struct SseNodeTest {
     /// Few enough values to live in registers while descending (BvhTraversal::walk_wide).
     static constexpr bool kCopyForDescent = true;
+    /// Whether the walk runs in AVX2 code and may use it for its own steps (walk_wide).
+    static constexpr bool kAvx2 = false;
     Float4 origin[3], inverse_near[3], inverse_far[3], t_min;
     int near_row[3], far_row[3];
 
@@ -271,6 +273,7 @@ struct SseNodeTest {
 /// (no fused multiply-add), so the same masks and entry distances.
 struct alignas(32) Avx2NodeTest {
     static constexpr bool kCopyForDescent = true;
+    static constexpr bool kAvx2 = true;
     __m256 origin[3], inverse_near[3], inverse_far[3], t_min;
     int near_row[3], far_row[3];
 
@@ -329,6 +332,7 @@ struct alignas(32) Avx2NodeTest {
 /// planes give infinite distances of the right signs.
 struct alignas(32) Avx2FusedNodeTest {
     static constexpr bool kCopyForDescent = true;
+    static constexpr bool kAvx2 = true;
     __m256 reciprocal[3], origin_reciprocal[3], t_min;
     /// Byte offsets in a node of the rows of each axis' near and far planes.
     std::ptrdiff_t near_row[3], far_row[3];
@@ -446,6 +450,7 @@ struct alignas(32) Avx2FusedNodeTest {
 struct alignas(32) PacketIntervalTest {
     /// Nineteen vectors: more than the registers hold, so a descent reads them where they are.
     static constexpr bool kCopyForDescent = false;
+    static constexpr bool kAvx2 = true;
     __m256 near_origin[3], far_origin[3], near_low[3], near_high[3], far_low[3], far_high[3];
     __m256 t_min;
     int near_row[3], far_row[3];
