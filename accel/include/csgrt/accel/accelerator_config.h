@@ -102,7 +102,8 @@ struct BvhConfig {
     /// four (SSE) or eight (AVX2, see `avx2`) at a time (8, the default, measured about 10% faster
     /// than 4 on the armadillo); 2: the binary tree is traversed as built.
     int width = 8;
-    /// Build large subtrees on several threads (oneTBB); the tree is the same either way.
+    /// Build large subtrees on several threads (oneTBB); the tree, and its nodes' order in
+    /// memory, are the same either way.
     bool parallel = true;
     /// For TriangleSet<float> sets: the BVH keeps its own copy of each leaf's triangles, four
     /// to a block in leaf order (BvhTriangleBlock), and tests a block's four at once with SIMD,

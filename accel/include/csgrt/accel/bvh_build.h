@@ -174,8 +174,9 @@ BinaryBvh build_binary_bvh(std::span<BuildPrimitive> primitives, const BvhConfig
 /// takes the place of a binary node and adopts up to kWidth descendants, opening the child
 /// with the largest surface area first. Leaves keep their offset and count. The root is node
 /// 0; a node's interior children are consecutive, each followed (after its siblings) by its
-/// own subtree, depth first; with `parallel` the top levels' subtrees are collapsed as parallel
-/// tasks and interleave in the array (the tree is the same, its layout differs between runs).
+/// own subtree, depth first. With `parallel` the top levels' subtrees are collapsed as parallel
+/// tasks, each into the nodes the serial collapse gives it: the array is the same, bit for bit,
+/// whatever the scheduling.
 template <int kWidth>
 WideBvhNodes<kWidth> collapse_to_wide(const BinaryBvh& binary, bool parallel);
 
