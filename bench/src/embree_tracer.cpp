@@ -144,7 +144,11 @@ private:
         }
     }
 
-    std::size_t nearest_packets(std::span<const Ray> rays) const {
+    /// Traces `rays` in packets of kPacket consecutive rays, each with a coherent context and
+    /// its lanes' valid flags set by fill_packet in `trace(context, valid, begin, lanes)`,
+    /// which returns how many of the packet's rays hit; returns the sum.
+    template <class Trace>
+    static std::size_t in_packets(std::span<const Ray> rays, const Trace& trace) {
         std::size_t hits = 0;
         for (std::size_t begin = 0; begin < rays.size(); begin += kPacket) {
             const int lanes = static_cast<int>(std::min<std::size_t>(kPacket, rays.size() - begin));
@@ -152,6 +156,14 @@ private:
             rtcInitIntersectContext(&context);
             context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
             alignas(32) int valid[kPacket];
+            hits += trace(context, valid, begin, lanes);
+        }
+        return hits;
+    }
+
+    std::size_t nearest_packets(std::span<const Ray> rays) const {
+        return in_packets(rays, [&](RTCIntersectContext& context, int* valid, std::size_t begin,
+                                    int lanes) {
             alignas(32) RTCRayHit8 query;
             fill_packet(rays, begin, lanes, query.ray, valid);
             for (int l = 0; l < kPacket; ++l) {
@@ -159,26 +171,24 @@ private:
                 query.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
             }
             rtcIntersect8(valid, scene_, &context, &query);
+            std::size_t hits = 0;
             for (int l = 0; l < lanes; ++l)
                 hits += query.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
-        }
-        return hits;
+            return hits;
+        });
     }
 
     std::size_t occluded_packets(std::span<const Ray> rays) const {
-        std::size_t hits = 0;
-        for (std::size_t begin = 0; begin < rays.size(); begin += kPacket) {
-            const int lanes = static_cast<int>(std::min<std::size_t>(kPacket, rays.size() - begin));
-            RTCIntersectContext context;
-            rtcInitIntersectContext(&context);
-            context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-            alignas(32) int valid[kPacket];
+        return in_packets(rays, [&](RTCIntersectContext& context, int* valid, std::size_t begin,
+                                    int lanes) {
             alignas(32) RTCRay8 query;
             fill_packet(rays, begin, lanes, query, valid);
             rtcOccluded8(valid, scene_, &context, &query);
+            std::size_t hits = 0;
+            // Embree marks an occluded ray by setting tfar to -inf.
             for (int l = 0; l < lanes; ++l) hits += query.tfar[l] == -INFINITY ? 1 : 0;
-        }
-        return hits;
+            return hits;
+        });
     }
 
     static void fill(const Ray& ray, RTCRay& query) {
