@@ -98,3 +98,13 @@ AcceleratorStats AcceleratorBase<Derived, Set>::stats() const {
 }
 
 }  // namespace csgrt
+
+/// Instantiates AcceleratorBase's overrides for `Structure` over each primitive set a
+/// structure serves (the two triangle sets and ShapeSet), in the source that defines
+/// Structure::query: the list of sets is written here once, not in every structure.
+#define CSGRT_INSTANTIATE_ACCELERATOR_BASE(Structure)                                          \
+    template class csgrt::AcceleratorBase<Structure<csgrt::TriangleSet<float>>,                \
+                                          csgrt::TriangleSet<float>>;                          \
+    template class csgrt::AcceleratorBase<Structure<csgrt::TriangleSet<double>>,               \
+                                          csgrt::TriangleSet<double>>;                         \
+    template class csgrt::AcceleratorBase<Structure<csgrt::ShapeSet>, csgrt::ShapeSet>

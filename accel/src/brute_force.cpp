@@ -73,8 +73,7 @@ bool BruteForce<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScr
 template class BruteForce<TriangleSet<float>>;
 template class BruteForce<TriangleSet<double>>;
 template class BruteForce<ShapeSet>;
-template class AcceleratorBase<BruteForce<TriangleSet<float>>, TriangleSet<float>>;
-template class AcceleratorBase<BruteForce<TriangleSet<double>>, TriangleSet<double>>;
-template class AcceleratorBase<BruteForce<ShapeSet>, ShapeSet>;
 
 }  // namespace csgrt
+
+CSGRT_INSTANTIATE_ACCELERATOR_BASE(csgrt::BruteForce);

@@ -25,8 +25,6 @@ bool Bvh<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& s
     return Traversal::template run<kKind, kCounted, false>(*this, ray, answer, scratch, counters);
 }
 
-template class AcceleratorBase<Bvh<TriangleSet<float>>, TriangleSet<float>>;
-template class AcceleratorBase<Bvh<TriangleSet<double>>, TriangleSet<double>>;
-template class AcceleratorBase<Bvh<ShapeSet>, ShapeSet>;
-
 }  // namespace csgrt
+
+CSGRT_INSTANTIATE_ACCELERATOR_BASE(csgrt::Bvh);

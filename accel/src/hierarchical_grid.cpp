@@ -232,8 +232,7 @@ bool HierarchicalGrid<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, Qu
 template class HierarchicalGrid<TriangleSet<float>>;
 template class HierarchicalGrid<TriangleSet<double>>;
 template class HierarchicalGrid<ShapeSet>;
-template class AcceleratorBase<HierarchicalGrid<TriangleSet<float>>, TriangleSet<float>>;
-template class AcceleratorBase<HierarchicalGrid<TriangleSet<double>>, TriangleSet<double>>;
-template class AcceleratorBase<HierarchicalGrid<ShapeSet>, ShapeSet>;
 
 }  // namespace csgrt
+
+CSGRT_INSTANTIATE_ACCELERATOR_BASE(csgrt::HierarchicalGrid);

@@ -342,8 +342,7 @@ template const RayClassification<ShapeSet>::Node* RayClassification<ShapeSet>::l
     int, const double[5], bool, TraversalCounters&, double[5], double[5], bool&) const;
 template RayClassification<ShapeSet>::Search RayClassification<ShapeSet>::find_candidates(
     const Ray&, TraversalCounters&, bool) const;
-template class AcceleratorBase<RayClassification<TriangleSet<float>>, TriangleSet<float>>;
-template class AcceleratorBase<RayClassification<TriangleSet<double>>, TriangleSet<double>>;
-template class AcceleratorBase<RayClassification<ShapeSet>, ShapeSet>;
 
 }  // namespace csgrt
+
+CSGRT_INSTANTIATE_ACCELERATOR_BASE(csgrt::RayClassification);

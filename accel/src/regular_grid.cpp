@@ -230,8 +230,7 @@ bool RegularGrid<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QuerySc
 template class RegularGrid<TriangleSet<float>>;
 template class RegularGrid<TriangleSet<double>>;
 template class RegularGrid<ShapeSet>;
-template class AcceleratorBase<RegularGrid<TriangleSet<float>>, TriangleSet<float>>;
-template class AcceleratorBase<RegularGrid<TriangleSet<double>>, TriangleSet<double>>;
-template class AcceleratorBase<RegularGrid<ShapeSet>, ShapeSet>;
 
 }  // namespace csgrt
+
+CSGRT_INSTANTIATE_ACCELERATOR_BASE(csgrt::RegularGrid);
