@@ -31,6 +31,14 @@ std::string one_line(std::string text) {
     return text;
 }
 
+/// The scene file every subcommand takes as its one positional argument.
+void add_scene_argument(CLI::App& subcommand, std::string& path) {
+    subcommand.add_option("scene", path, "The JSON scene file")
+        ->required()
+        ->check(CLI::ExistingFile)
+        ->type_name("SCENE.json");
+}
+
 }  // namespace
 
 int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
@@ -68,10 +76,7 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
         "false colour, with a scale). Prints one summary line: time, Mrays/s, the structure (with\n"
         "--json, one JSON object instead); --stats adds a table of rays, hits, the structure's "
         "work and time per stage.");
-    render->add_option("scene", options.scene, "The JSON scene file")
-        ->required()
-        ->check(CLI::ExistingFile)
-        ->type_name("SCENE.json");
+    add_scene_argument(*render, options.scene);
     render->add_option("-o,--output", options.output, "The EXR file to write")
         ->required()
         ->type_name("OUT.exr");
@@ -128,20 +133,14 @@ int run_csgrt(int argc, const char* const* argv, CommandLineStreams streams) {
         "Counts every shape by kind through the whole tree (instances, booleans, compounds;\n"
         "a shared shape once per use), and prints materials, lights, camera, world bounds\n"
         "and the structure 'auto' picks for the top-level objects, with the reason.");
-    info->add_option("scene", scene_path, "The JSON scene file")
-        ->required()
-        ->check(CLI::ExistingFile)
-        ->type_name("SCENE.json");
+    add_scene_argument(*info, scene_path);
     info->add_flag("--json", info_json, "Print the description as one JSON object");
     CLI::App* validate =
         app.add_subcommand("validate", "Check a scene file (errors only; exit 0 when usable)");
     validate->footer(
         "Loads and commits the scene. Prints nothing and exits 0 when it is usable; otherwise\n"
         "prints the first error (file, place in the file, what was expected) and exits 1.");
-    validate->add_option("scene", scene_path, "The JSON scene file")
-        ->required()
-        ->check(CLI::ExistingFile)
-        ->type_name("SCENE.json");
+    add_scene_argument(*validate, scene_path);
 
     try {
         // CLI11 would report a mistyped subcommand as a missing one.
