@@ -71,22 +71,20 @@ struct BvhTraversal {
 #endif
         const BoxRay box_ray(ray);
         if (!box_ray.valid) return false;
+        // The SSE node test of a wide tree, in its signed form only for rays that need it.
+        auto traverse_sse = [&]<int kWidth>(const WideBvhNodes<kWidth>& nodes) {
+            if (box_ray.signed_interval) {
+                traverse_wide<kCount, true, kNearestFirst, SseNodeTest<kWidth>>(
+                    bvh, nodes, box_ray, ray.t_max, counters, leaf);
+            } else {
+                traverse_wide<kCount, false, kNearestFirst, SseNodeTest<kWidth>>(
+                    bvh, nodes, box_ray, ray.t_max, counters, leaf);
+            }
+        };
         if (bvh.config_.width == 8) {
-            if (box_ray.signed_interval) {
-                traverse_wide<kCount, true, kNearestFirst, SseNodeTest<8>>(
-                    bvh, bvh.nodes_8_, box_ray, ray.t_max, counters, leaf);
-            } else {
-                traverse_wide<kCount, false, kNearestFirst, SseNodeTest<8>>(
-                    bvh, bvh.nodes_8_, box_ray, ray.t_max, counters, leaf);
-            }
+            traverse_sse(bvh.nodes_8_);
         } else if (bvh.config_.width == 4) {
-            if (box_ray.signed_interval) {
-                traverse_wide<kCount, true, kNearestFirst, SseNodeTest<4>>(
-                    bvh, bvh.nodes_4_, box_ray, ray.t_max, counters, leaf);
-            } else {
-                traverse_wide<kCount, false, kNearestFirst, SseNodeTest<4>>(
-                    bvh, bvh.nodes_4_, box_ray, ray.t_max, counters, leaf);
-            }
+            traverse_sse(bvh.nodes_4_);
         } else if (box_ray.signed_interval) {
             traverse_binary<kCount, true>(bvh, box_ray, ray.t_max, counters, leaf);
         } else {
