@@ -246,6 +246,21 @@ void expect_same_answers_concurrently(const Accelerator<Set>& structure,
     EXPECT_EQ(mismatches, 0);
 }
 
+/// A `Structure` built over `mesh` in precision Real answers `count` incoherent rays around the
+/// mesh (seed `seed`) and `count` camera rays toward `camera_target` (seed + 1) from four threads
+/// at once as it answers them from one (expect_same_answers_concurrently).
+template <class Real, template <class> class Structure>
+void expect_concurrent_answers_on_mesh(const TestMesh& mesh, const Aabb& camera_target, int count,
+                                       std::uint64_t seed) {
+    const TriangleSet<Real> set(mesh.vertices, mesh.triangles);
+    Structure<TriangleSet<Real>> structure;
+    structure.build(set);
+    std::vector<Ray> rays = incoherent_rays(mesh_bounds(mesh), count, seed);
+    const std::vector<Ray> camera = camera_rays(camera_target, count, seed + 1);
+    rays.insert(rays.end(), camera.begin(), camera.end());
+    expect_same_answers_concurrently(structure, rays, 4);
+}
+
 /// The cell boundary plane of `grid` along `axis` nearest to `x`, computed as the grid does.
 inline double boundary_near(const detail::GridGeometry& grid, int axis, double x) {
     const double i = std::round((x - grid.bounds.lower[axis]) / grid.cell_size[axis]);

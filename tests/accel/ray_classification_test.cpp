@@ -15,6 +15,7 @@
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
 #include "support/meshes.h"
+#include "support/precisions.h"
 #include "support/random.h"
 #include "support/test_scale.h"
 
@@ -150,8 +151,7 @@ test::TestMesh teapot_in_stadium() {
 
 template <class Real>
 class RayClassificationTest : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(RayClassificationTest, Precisions);
+TYPED_TEST_SUITE(RayClassificationTest, test::Precisions);
 
 TYPED_TEST(RayClassificationTest, SameHitsAsBruteForceOnInCodeMeshes) {
     struct Case {

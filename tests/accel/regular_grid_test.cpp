@@ -4,6 +4,7 @@
 
 #include "accel/grid_test_common.h"
 #include "csgrt/core/error.h"
+#include "support/precisions.h"
 
 namespace csgrt {
 namespace {
@@ -12,8 +13,7 @@ using test::TestMesh;
 
 template <class Real>
 class RegularGridTest : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(RegularGridTest, Precisions);
+TYPED_TEST_SUITE(RegularGridTest, test::Precisions);
 
 // The agreement on in-code meshes at the default settings is in grid_agreement_test.cpp.
 TYPED_TEST(RegularGridTest, AgreesWithBruteForceAtOtherResolutions) {
@@ -93,14 +93,8 @@ TYPED_TEST(RegularGridTest, InvalidRaysGiveNoHitAndNoHang) {
 
 TYPED_TEST(RegularGridTest, ConcurrentQueriesGiveTheSameAnswers) {
     const TestMesh sphere = test::sphere_mesh(5);
-    const TriangleSet<TypeParam> set(sphere.vertices, sphere.triangles);
-    RegularGrid<TriangleSet<TypeParam>> grid;
-    grid.build(set);
-    const Aabb box = test::mesh_bounds(sphere);
-    std::vector<Ray> rays = test::incoherent_rays(box, 20000, 14);
-    const std::vector<Ray> camera = test::camera_rays(box, 20000, 15);
-    rays.insert(rays.end(), camera.begin(), camera.end());
-    test::expect_same_answers_concurrently(grid, rays, 4);
+    test::expect_concurrent_answers_on_mesh<TypeParam, RegularGrid>(
+        sphere, test::mesh_bounds(sphere), 20000, 14);
 }
 
 TEST(RegularGrid, FindsFloatHitsJustOutsideATriangleAcrossACellBoundary) {
