@@ -544,11 +544,7 @@ TEST(Bvh, Avx2AndSseTraversalsDoTheSameWorkRayByRay) {
 }
 
 TEST(Bvh, EmptySetAndSinglePrimitive) {
-    const TriangleSet<float> empty;
-    Bvh<TriangleSet<float>> bvh;
-    bvh.build(empty);
-    test::expect_empty_set_answers_nothing(bvh);
-    EXPECT_EQ(bvh.stats().primitives, 0u);
+    test::expect_empty_structure_answers_nothing<float, Bvh>();
 
     QueryScratch scratch;
     HitRecord record;

@@ -511,6 +511,18 @@ void expect_empty_set_answers_nothing(const Accelerator<Set>& structure) {
     EXPECT_TRUE(hits.empty());
 }
 
+/// A `Structure` built over an empty triangle set in precision Real answers nothing
+/// (expect_empty_set_answers_nothing), and its stats count no primitive and no reference.
+template <class Real, template <class> class Structure>
+void expect_empty_structure_answers_nothing() {
+    const TriangleSet<Real> empty;
+    Structure<TriangleSet<Real>> structure;
+    structure.build(empty);
+    expect_empty_set_answers_nothing(structure);
+    EXPECT_EQ(structure.stats().primitives, 0u) << structure.name();
+    EXPECT_EQ(structure.stats().references, 0u) << structure.name();
+}
+
 /// The triangle (0, 0, 0), (2, 0, 0), (0, 2, 0), for expect_single_triangle_answers.
 inline TestMesh single_triangle() {
     TestMesh mesh;

@@ -284,11 +284,7 @@ TYPED_TEST(RayClassificationTest, InvalidRaysHitNothingAndDoNotHang) {
 }
 
 TYPED_TEST(RayClassificationTest, EmptySetAndOnePrimitive) {
-    const TriangleSet<TypeParam> empty;
-    RayClassification<TriangleSet<TypeParam>> none;
-    none.build(empty);
-    test::expect_empty_set_answers_nothing(none);
-    EXPECT_EQ(none.stats().primitives, 0u);
+    test::expect_empty_structure_answers_nothing<TypeParam, RayClassification>();
     const test::TestMesh triangle = test::single_triangle();
     const test::BuiltMesh<TypeParam, RayClassification> one(triangle);
     test::expect_single_triangle_answers(one.structure);

@@ -73,11 +73,7 @@ TYPED_TEST(RegularGridTest, IdenticalTrianglesShareOneCellAndTiesGoToTheLowestIn
 }
 
 TYPED_TEST(RegularGridTest, EmptySetAndSinglePrimitive) {
-    const TriangleSet<TypeParam> empty;
-    RegularGrid<TriangleSet<TypeParam>> grid;
-    grid.build(empty);
-    test::expect_empty_set_answers_nothing(grid);
-    EXPECT_EQ(grid.stats().references, 0u);
+    test::expect_empty_structure_answers_nothing<TypeParam, RegularGrid>();
     const test::BuiltMesh<TypeParam, RegularGrid> one(test::single_triangle());
     EXPECT_EQ(one.structure.geometry().resolution[2], 1);  // flat in z: one cell across
     test::expect_single_triangle_answers(one.structure);
