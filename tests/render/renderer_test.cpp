@@ -159,11 +159,12 @@ Scene unit_sphere_seen_from(double distance, const Vector3& albedo) {
     return scene;
 }
 
-/// `pixel`'s colour is `expected` to the rounding of its half storage (2^-11 relative), doubled.
-void expect_half_colour(const Pixel& pixel, const Vector3& expected) {
-    EXPECT_NEAR(pixel.red, expected.x(), expected.x() * 0x1.0p-10);
-    EXPECT_NEAR(pixel.green, expected.y(), expected.y() * 0x1.0p-10);
-    EXPECT_NEAR(pixel.blue, expected.z(), expected.z() * 0x1.0p-10);
+/// `pixel`'s colour is `expected` to the rounding of its half storage (2^-11 relative), doubled;
+/// `label` names the pixel.
+void expect_half_colour(const Pixel& pixel, const Vector3& expected, const char* label) {
+    EXPECT_NEAR(pixel.red, expected.x(), expected.x() * 0x1.0p-10) << label;
+    EXPECT_NEAR(pixel.green, expected.y(), expected.y() * 0x1.0p-10) << label;
+    EXPECT_NEAR(pixel.blue, expected.z(), expected.z() * 0x1.0p-10) << label;
 }
 
 TEST(Render, LambertShadingOfPointAndDirectionalLightsMatchesTheFormula) {
@@ -179,7 +180,7 @@ TEST(Render, LambertShadingOfPointAndDirectionalLightsMatchesTheFormula) {
     const Vector3 expected =
         albedo.cwiseProduct(intensity / 22.0 * (3.0 / std::sqrt(22.0)) + radiance) / kPi;
     const Pixel& pixel = result.image.at(15, 15);
-    expect_half_colour(pixel, expected);
+    expect_half_colour(pixel, expected, "centre pixel");
     EXPECT_EQ(pixel.alpha, 1.0f);
     // Both lights face every visible point near the centre; all get two shadow rays, fewer
     // near the rim, where the lights are behind the surface.
@@ -240,7 +241,7 @@ TEST(Render, ASceneWithoutLightsIsLitFromTheEyeAndCastsNoShadowRays) {
     // With one sample, the centre ray is on the axis: exactly the albedo (half-rounded).
     // A copy: the RenderResult is a temporary that dies at the end of this statement.
     const Pixel centre = render(scene, test::settings_of_size(21, 21, 1)).image.at(10, 10);
-    expect_half_colour(centre, albedo);
+    expect_half_colour(centre, albedo, "centre pixel, one sample");
 }
 
 TEST(Render, CountsPrimaryAndShadowRays) {
