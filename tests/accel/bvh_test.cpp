@@ -19,6 +19,7 @@
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
 #include "support/meshes.h"
+#include "support/precisions.h"
 #include "support/random.h"
 #include "support/test_scale.h"
 
@@ -162,16 +163,9 @@ TestMesh teapot_in_stadium() {
     return mesh;
 }
 
-Aabb mesh_box(const TestMesh& mesh) {
-    Aabb box;
-    for (const auto& vertex : mesh.vertices) box.extend(vertex);
-    return box;
-}
-
 template <class Real>
 class BvhMeshTest : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(BvhMeshTest, Precisions);
+TYPED_TEST_SUITE(BvhMeshTest, test::Precisions);
 
 TYPED_TEST(BvhMeshTest, SameHitsAsBruteForceOnEveryMeshAndLayout) {
     // The tie rule makes the nearest hit independent of test order, so the BVH must return
@@ -195,7 +189,7 @@ TYPED_TEST(BvhMeshTest, SameHitsAsBruteForceOnEveryMeshAndLayout) {
         // independent of the BVH's float one, and it returns what the plain loop returns.
         BruteForce<TriangleSet<TypeParam>> brute;
         brute.build(set, BruteForceConfig{.box_culling = true});
-        Aabb box = mesh_box(c.mesh);
+        Aabb box = test::mesh_bounds(c.mesh);
         // In the stadium, aim at the teapot: that is where the cost and the precision are.
         if (c.name == "teapot in stadium")
             box = Aabb(Point3(-0.2, -0.2, -0.2), Point3(0.2, 0.2, 0.2));
@@ -274,7 +268,7 @@ TYPED_TEST(BvhMeshTest, PacketsGiveTheSingleRayAnswersBitForBit) {
         brute.build(set, BruteForceConfig{.box_culling = true});
         const Aabb box = c.name == "teapot in stadium"
                              ? Aabb(Point3(-0.2, -0.2, -0.2), Point3(0.2, 0.2, 0.2))
-                             : mesh_box(c.mesh);
+                             : test::mesh_bounds(c.mesh);
         std::vector<Ray> rays = camera_grid(box, 45);
         const std::vector<Ray> mixed = mixed_rays(box, test::scaled(3001), 77);
         rays.insert(rays.end(), mixed.begin(), mixed.end());
@@ -420,7 +414,7 @@ TEST(Bvh, TriangleBlocksGiveTheScalarTestsBitsOnEdgeAndVertexRays) {
         avx2.build(set);
         sse.build(set, BvhConfig{.avx2 = false});
         ASSERT_FALSE(avx2.leaf_triangles().empty());
-        const Aabb box = mesh_box(mesh);
+        const Aabb box = test::mesh_bounds(mesh);
         QueryScratch scratch;
         int failures = 0;
         std::size_t total_hits = 0;
@@ -513,7 +507,7 @@ TEST(Bvh, Avx2AndSseTraversalsDoTheSameWorkRayByRay) {
     QueryScratch scratch;
     int signed_rays = 0, fused_rays = 0, differing_rays = 0;
     std::size_t nodes_avx2 = 0, nodes_sse = 0, primitives_avx2 = 0, primitives_sse = 0;
-    for (const Ray& ray : mixed_rays(mesh_box(mesh), 20000, 18)) {
+    for (const Ray& ray : mixed_rays(test::mesh_bounds(mesh), 20000, 18)) {
         TraversalCounters a, b;
         HitRecord ra, rb;
         const Answer answer_a = Answer::of(avx2.intersect_counted(ray, ra, scratch, a), ra);
@@ -550,11 +544,7 @@ TEST(Bvh, Avx2AndSseTraversalsDoTheSameWorkRayByRay) {
 }
 
 TEST(Bvh, EmptySetAndSinglePrimitive) {
-    const TriangleSet<float> empty;
-    Bvh<TriangleSet<float>> bvh;
-    bvh.build(empty);
-    test::expect_empty_set_answers_nothing(bvh);
-    EXPECT_EQ(bvh.stats().primitives, 0u);
+    test::expect_empty_structure_answers_nothing<float, Bvh>();
 
     QueryScratch scratch;
     HitRecord record;
@@ -638,12 +628,8 @@ TEST(Bvh, FlatMeshWithParallelAndGrazingRays) {
 }
 
 TEST(Bvh, InvalidAndExtremeRays) {
-    const TestMesh mesh = test::sphere_mesh(3);
-    const TriangleSet<double> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<double>> brute;
-    brute.build(set);
-    Bvh<TriangleSet<double>> bvh;
-    bvh.build(set);
+    const test::BuiltMesh<double, Bvh> built(test::sphere_mesh(3));
+    const auto& [set, brute, bvh] = built;
     QueryScratch scratch;
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (const Ray& ray :
@@ -899,12 +885,8 @@ TEST(Bvh, CountedQueriesDoFarLessWorkThanBruteForce) {
     // visits about 8 nodes (leaves included) and tests about 2.6 triangles per ray here
     // (measured), so nodes + triangles per ray must stay under 1/1000 of brute force's
     // triangle tests (about 10 against 33: a factor 3 of headroom).
-    const TestMesh mesh = test::sphere_mesh(6);
-    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
-    Bvh<TriangleSet<float>> bvh;
-    bvh.build(set);
-    BruteForce<TriangleSet<float>> brute;
-    brute.build(set);
+    const test::BuiltMesh<float, Bvh> built(test::sphere_mesh(6));
+    const auto& [set, brute, bvh] = built;
     QueryScratch scratch;
     test::Random random(15);
     TraversalCounters tree, naive;
@@ -927,7 +909,7 @@ TEST(Bvh, ConcurrentQueriesGiveTheSameAnswers) {
     const TriangleSet<float> set(mesh.vertices, mesh.triangles);
     Bvh<TriangleSet<float>> bvh;
     bvh.build(set);
-    const std::vector<Ray> rays = mixed_rays(mesh_box(mesh), 20000, 16);
+    const std::vector<Ray> rays = mixed_rays(test::mesh_bounds(mesh), 20000, 16);
     std::vector<Answer> expected(rays.size());
     QueryScratch scratch;
     for (std::size_t i = 0; i < rays.size(); ++i) {

@@ -4,6 +4,7 @@
 
 #include "csgrt/accel/brute_force.h"
 #include "support/meshes.h"
+#include "support/precisions.h"
 #include "support/random.h"
 #include "support/reference_check.h"
 
@@ -31,8 +32,7 @@ TEST(CgalReference, AnalyticTriangle) {
 
 template <class Real>
 class ReferenceAgreement : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(ReferenceAgreement, Precisions);
+TYPED_TEST_SUITE(ReferenceAgreement, test::Precisions);
 
 TYPED_TEST(ReferenceAgreement, BruteForceAgreesWithExactPredicates) {
     // The watertight test against CGAL's exact predicates on a closed sphere mesh and on an

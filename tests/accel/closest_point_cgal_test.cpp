@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "support/meshes.h"
+#include "support/precisions.h"
 #include "support/random.h"
 #include "support/rays.h"
 
@@ -75,8 +76,7 @@ TEST(ClosestPointOnTriangle, EveryVoronoiRegionAgainstTheClosedForm) {
 
 template <class Real>
 class ClosestPointTreeTest : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(ClosestPointTreeTest, Precisions);
+TYPED_TEST_SUITE(ClosestPointTreeTest, test::Precisions);
 
 TYPED_TEST(ClosestPointTreeTest, BitsOfBruteForceAndDistanceOfCgal) {
     using Real = TypeParam;

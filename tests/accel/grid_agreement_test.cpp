@@ -7,6 +7,7 @@
 #include "accel/grid_test_common.h"
 #include "csgrt/accel/hierarchical_grid.h"
 #include "csgrt/accel/regular_grid.h"
+#include "support/precisions.h"
 
 namespace csgrt {
 namespace {
@@ -38,8 +39,7 @@ protected:
         return counts.rays;
     }
 };
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(GridAgreementTest, Precisions);
+TYPED_TEST_SUITE(GridAgreementTest, test::Precisions);
 
 // Together these check 112,350 rays per precision against brute force, for each grid.
 TYPED_TEST(GridAgreementTest, IntegerCube) {

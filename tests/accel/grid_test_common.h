@@ -246,6 +246,21 @@ void expect_same_answers_concurrently(const Accelerator<Set>& structure,
     EXPECT_EQ(mismatches, 0);
 }
 
+/// A `Structure` built over `mesh` in precision Real answers `count` incoherent rays around the
+/// mesh (seed `seed`) and `count` camera rays toward `camera_target` (seed + 1) from four threads
+/// at once as it answers them from one (expect_same_answers_concurrently).
+template <class Real, template <class> class Structure>
+void expect_concurrent_answers_on_mesh(const TestMesh& mesh, const Aabb& camera_target, int count,
+                                       std::uint64_t seed) {
+    const TriangleSet<Real> set(mesh.vertices, mesh.triangles);
+    Structure<TriangleSet<Real>> structure;
+    structure.build(set);
+    std::vector<Ray> rays = incoherent_rays(mesh_bounds(mesh), count, seed);
+    const std::vector<Ray> camera = camera_rays(camera_target, count, seed + 1);
+    rays.insert(rays.end(), camera.begin(), camera.end());
+    expect_same_answers_concurrently(structure, rays, 4);
+}
+
 /// The cell boundary plane of `grid` along `axis` nearest to `x`, computed as the grid does.
 inline double boundary_near(const detail::GridGeometry& grid, int axis, double x) {
     const double i = std::round((x - grid.bounds.lower[axis]) / grid.cell_size[axis]);
@@ -494,6 +509,18 @@ void expect_empty_set_answers_nothing(const Accelerator<Set>& structure) {
     std::vector<HitRecord> hits;
     structure.all_hits(ray, hits, scratch);
     EXPECT_TRUE(hits.empty());
+}
+
+/// A `Structure` built over an empty triangle set in precision Real answers nothing
+/// (expect_empty_set_answers_nothing), and its stats count no primitive and no reference.
+template <class Real, template <class> class Structure>
+void expect_empty_structure_answers_nothing() {
+    const TriangleSet<Real> empty;
+    Structure<TriangleSet<Real>> structure;
+    structure.build(empty);
+    expect_empty_set_answers_nothing(structure);
+    EXPECT_EQ(structure.stats().primitives, 0u) << structure.name();
+    EXPECT_EQ(structure.stats().references, 0u) << structure.name();
 }
 
 /// The triangle (0, 0, 0), (2, 0, 0), (0, 2, 0), for expect_single_triangle_answers.

@@ -4,6 +4,7 @@
 
 #include "accel/grid_test_common.h"
 #include "csgrt/core/error.h"
+#include "support/precisions.h"
 
 namespace csgrt {
 namespace {
@@ -22,8 +23,7 @@ detail::GridGeometry top_geometry(const TestMesh& mesh) {
 
 template <class Real>
 class HierarchicalGridTest : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(HierarchicalGridTest, Precisions);
+TYPED_TEST_SUITE(HierarchicalGridTest, test::Precisions);
 
 // The agreement on in-code meshes at the default settings is in grid_agreement_test.cpp.
 TYPED_TEST(HierarchicalGridTest, AgreesWithBruteForceUnderOtherSettings) {
@@ -103,16 +103,9 @@ TYPED_TEST(HierarchicalGridTest, InvalidRaysGiveNoHitAndNoHang) {
 }
 
 TYPED_TEST(HierarchicalGridTest, ConcurrentQueriesGiveTheSameAnswers) {
-    const TestMesh mesh = test::teapot_in_stadium();
-    const TriangleSet<TypeParam> set(mesh.vertices, mesh.triangles);
-    HierarchicalGrid<TriangleSet<TypeParam>> hgrid;
-    hgrid.build(set);
-    const Aabb box = test::mesh_bounds(mesh);
-    std::vector<Ray> rays = test::incoherent_rays(box, 20000, 216);
-    const std::vector<Ray> camera =
-        test::camera_rays(Aabb(Point3(-1, -1, -1), Point3(1, 1, 1)), 20000, 217);
-    rays.insert(rays.end(), camera.begin(), camera.end());
-    test::expect_same_answers_concurrently(hgrid, rays, 4);
+    // Camera rays toward the teapot only, where the sub-grids are.
+    test::expect_concurrent_answers_on_mesh<TypeParam, HierarchicalGrid>(
+        test::teapot_in_stadium(), Aabb(Point3(-1, -1, -1), Point3(1, 1, 1)), 20000, 216);
 }
 
 TYPED_TEST(HierarchicalGridTest, NearlyCoincidentTrianglesAcrossACellBoundary) {

@@ -15,6 +15,7 @@
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/core/error.h"
 #include "support/meshes.h"
+#include "support/precisions.h"
 #include "support/random.h"
 #include "support/test_scale.h"
 
@@ -150,8 +151,7 @@ test::TestMesh teapot_in_stadium() {
 
 template <class Real>
 class RayClassificationTest : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(RayClassificationTest, Precisions);
+TYPED_TEST_SUITE(RayClassificationTest, test::Precisions);
 
 TYPED_TEST(RayClassificationTest, SameHitsAsBruteForceOnInCodeMeshes) {
     struct Case {
@@ -284,11 +284,7 @@ TYPED_TEST(RayClassificationTest, InvalidRaysHitNothingAndDoNotHang) {
 }
 
 TYPED_TEST(RayClassificationTest, EmptySetAndOnePrimitive) {
-    const TriangleSet<TypeParam> empty;
-    RayClassification<TriangleSet<TypeParam>> none;
-    none.build(empty);
-    test::expect_empty_set_answers_nothing(none);
-    EXPECT_EQ(none.stats().primitives, 0u);
+    test::expect_empty_structure_answers_nothing<TypeParam, RayClassification>();
     const test::TestMesh triangle = test::single_triangle();
     const test::BuiltMesh<TypeParam, RayClassification> one(triangle);
     test::expect_single_triangle_answers(one.structure);

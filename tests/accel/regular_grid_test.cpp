@@ -4,6 +4,7 @@
 
 #include "accel/grid_test_common.h"
 #include "csgrt/core/error.h"
+#include "support/precisions.h"
 
 namespace csgrt {
 namespace {
@@ -12,8 +13,7 @@ using test::TestMesh;
 
 template <class Real>
 class RegularGridTest : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(RegularGridTest, Precisions);
+TYPED_TEST_SUITE(RegularGridTest, test::Precisions);
 
 // The agreement on in-code meshes at the default settings is in grid_agreement_test.cpp.
 TYPED_TEST(RegularGridTest, AgreesWithBruteForceAtOtherResolutions) {
@@ -73,11 +73,7 @@ TYPED_TEST(RegularGridTest, IdenticalTrianglesShareOneCellAndTiesGoToTheLowestIn
 }
 
 TYPED_TEST(RegularGridTest, EmptySetAndSinglePrimitive) {
-    const TriangleSet<TypeParam> empty;
-    RegularGrid<TriangleSet<TypeParam>> grid;
-    grid.build(empty);
-    test::expect_empty_set_answers_nothing(grid);
-    EXPECT_EQ(grid.stats().references, 0u);
+    test::expect_empty_structure_answers_nothing<TypeParam, RegularGrid>();
     const test::BuiltMesh<TypeParam, RegularGrid> one(test::single_triangle());
     EXPECT_EQ(one.structure.geometry().resolution[2], 1);  // flat in z: one cell across
     test::expect_single_triangle_answers(one.structure);
@@ -93,14 +89,8 @@ TYPED_TEST(RegularGridTest, InvalidRaysGiveNoHitAndNoHang) {
 
 TYPED_TEST(RegularGridTest, ConcurrentQueriesGiveTheSameAnswers) {
     const TestMesh sphere = test::sphere_mesh(5);
-    const TriangleSet<TypeParam> set(sphere.vertices, sphere.triangles);
-    RegularGrid<TriangleSet<TypeParam>> grid;
-    grid.build(set);
-    const Aabb box = test::mesh_bounds(sphere);
-    std::vector<Ray> rays = test::incoherent_rays(box, 20000, 14);
-    const std::vector<Ray> camera = test::camera_rays(box, 20000, 15);
-    rays.insert(rays.end(), camera.begin(), camera.end());
-    test::expect_same_answers_concurrently(grid, rays, 4);
+    test::expect_concurrent_answers_on_mesh<TypeParam, RegularGrid>(
+        sphere, test::mesh_bounds(sphere), 20000, 14);
 }
 
 TEST(RegularGrid, FindsFloatHitsJustOutsideATriangleAcrossACellBoundary) {

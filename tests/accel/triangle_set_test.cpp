@@ -4,6 +4,7 @@
 
 #include "csgrt/accel/brute_force.h"
 #include "support/meshes.h"
+#include "support/precisions.h"
 #include "support/random.h"
 
 namespace csgrt {
@@ -11,8 +12,7 @@ namespace {
 
 template <class Real>
 class TriangleSetTest : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(TriangleSetTest, Precisions);
+TYPED_TEST_SUITE(TriangleSetTest, test::Precisions);
 
 TYPED_TEST(TriangleSetTest, AnalyticHitWithBarycentrics) {
     const std::vector<Eigen::Vector3d> vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};

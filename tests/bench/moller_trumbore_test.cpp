@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "csgrt/accel/triangle_set.h"
+#include "support/precisions.h"
 #include "support/random.h"
 
 namespace csgrt::bench {
@@ -28,8 +29,7 @@ TEST(MollerTrumbore, AnalyticHit) {
 
 template <class Real>
 class MollerTrumboreAgreement : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(MollerTrumboreAgreement, Precisions);
+TYPED_TEST_SUITE(MollerTrumboreAgreement, test::Precisions);
 
 TYPED_TEST(MollerTrumboreAgreement, SameAnswersAsWatertightAwayFromEdges) {
     // Rays through random points of random triangles, at least 1% of the triangle's size from

@@ -146,12 +146,10 @@ TEST(Annulus, MatchesALongDoubleSolve) {
                               random.unit_vector(), random.uniform(0, 0.8) * outer, outer, phi_min,
                               phi_min + random.uniform(0.2, kTwoPi));
         const Ray ray = random.ray_between(test::enlarged(annulus.bounds(), 2.0), annulus.bounds());
-        const LongVector c = annulus.center().cast<long double>();
-        const LongVector n = annulus.normal().cast<long double>();
-        const LongVector o = ray.origin.cast<long double>();
-        const LongVector d = ray.direction.cast<long double>();
-        const long double t = (c - o).dot(n) / d.dot(n);
-        const LongVector q = o + t * d - c;
+        const test::LongPlaneSolve solve =
+            test::long_plane_solve(annulus.center(), annulus.normal(), ray);
+        const long double t = solve.t;
+        const LongVector q = solve.offset();
         const long double r = q.norm();
         const long double x = q.dot(annulus.frame().x_axis.cast<long double>());
         const long double z = q.dot(annulus.frame().z_axis.cast<long double>());
@@ -173,8 +171,7 @@ TEST(Annulus, MatchesALongDoubleSolve) {
         if (!hit) continue;
         ++hits;
         // The plane solve's forward error, as for the plane.
-        EXPECT_NEAR(hit->t, double(t), double(test::plane_solve_bound(c, o, d, n, t)))
-            << "ray " << i;
+        EXPECT_NEAR(hit->t, double(t), double(solve.bound())) << "ray " << i;
         const long double radial =
             (r - annulus.inner_radius()) / (annulus.outer_radius() - annulus.inner_radius());
         EXPECT_NEAR(hit->uv.x(), double(radial), 1e-12);
@@ -189,10 +186,8 @@ TEST(Annulus, PropertiesOnRandomRays) {
          {std::tuple{0.6, 0.0, kTwoPi}, std::tuple{0.0, 1.0, 4.0}, std::tuple{0.4, 5.0, 8.5}}) {
         const Annulus annulus(Point3(0.3, -1.2, 2.0), Normal3(0.2, 1.0, -0.4), inner, 1.7, phi_min,
                               phi_max);
-        const test::SurfaceDescription surface{
-            [&](const Point3& p) { return (p - annulus.center()).dot(annulus.normal()); },
-            [&](const Point3&) { return Vector3(annulus.normal()); }, annulus.outer_radius(),
-            annulus.bounds()};
+        const test::SurfaceDescription surface = test::plane_surface(
+            annulus.center(), annulus.normal(), annulus.outer_radius(), annulus.bounds());
         const test::PropertyCounts counts =
             test::check_shape_properties(annulus, surface, 100000, 92);
         EXPECT_EQ(counts.rays, 100000);

@@ -59,11 +59,7 @@ TEST(Box, EveryFaceHasItsOutwardNormal) {
 
 TEST(Box, FromInsideHitsTheExitFaceFromBehind) {
     const Ray ray{Point3(0, 0, 0), Vector3(0, 0.5, 0)};
-    const std::optional<Hit> hit = kCube.intersect(ray);
-    ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 2.0);
-    EXPECT_EQ(hit->geometric_normal, Normal3(0, 1, 0));
-    EXPECT_FALSE(hit->front_face);
+    ASSERT_TRUE(test::expect_hit_from_behind(kCube, ray, 2.0, Normal3(0, 1, 0)));
     const SpanList spans = kCube.spans(ray);
     ASSERT_EQ(spans.size(), 1u);
     EXPECT_EQ(spans[0].enter.t, -2.0);  // the line's interval, not clipped to the ray
@@ -197,8 +193,7 @@ TEST(Box, MatchesLongDoubleFaceByFaceCrossings) {
         const Point3 a = random.in_box(Aabb(Point3(-5, -5, -5), Point3(5, 5, 5)));
         const Point3 b = random.in_box(Aabb(Point3(-5, -5, -5), Point3(5, 5, 5)));
         const Box box(a.cwiseMin(b), a.cwiseMax(b));
-        Ray ray = random.ray_between(test::enlarged(box.bounds(), 1.0), box.bounds());
-        if (i % 4 == 0) ray.origin = random.in_box(box.bounds());
+        Ray ray = test::ray_toward(random, box.bounds(), i);
         long double best = kInfinity;
         int best_face = -1;
         bool ambiguous = false;

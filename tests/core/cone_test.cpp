@@ -435,9 +435,8 @@ long double reference_t(const Cone& cone, const Ray& ray) {
 }
 
 // Rays from origins `distance` times the cone's size away, aimed at random points of the side
-// and caps away from the edges and the apex. Error and bound as for the Cylinder: a distance
-// along the ray relative to |o| + |t d| + size, at most (16 / cos + 8) u, from moving the
-// origin (~2 u |o| per coordinate, over the cosine between ray and normal) and the roots.
+// and caps away from the edges and the apex. Error and bound as for every shape of revolution:
+// test::AlongRayError, at most (16 / cos + 8) u.
 void expect_accurate_from_afar(const Cone& cone, double distance, std::uint64_t seed) {
     test::Random random(seed);
     const double size = std::max({cone.base_radius(), cone.top_radius(), cone.height()});
@@ -465,13 +464,10 @@ void expect_accurate_from_afar(const Cone& cone, double distance, std::uint64_t 
         ASSERT_EQ(hit.has_value(), std::isfinite(expected)) << "ray " << i;
         if (!hit) continue;
         ++hits;
-        const double cosine = std::abs(ray.direction.normalized().dot(hit->geometric_normal));
-        const double magnitude = ray.origin.norm() + std::abs(hit->t) * ray.direction.norm() + size;
-        const double error =
-            static_cast<double>(std::abs(hit->t - expected)) * ray.direction.norm() / magnitude;
-        worst = std::max(worst, error * std::max(cosine, 1e-3) / kUnitRoundoff);
-        EXPECT_LE(error, kUnitRoundoff * (16.0 / std::max(cosine, 1e-3) + 8.0))
-            << "ray " << i << " at " << distance << ", cosine " << cosine;
+        const test::AlongRayError along = test::along_ray_error(ray, *hit, expected, size);
+        worst = std::max(worst, along.scaled());
+        EXPECT_LE(along.error, along.bound())
+            << "ray " << i << " at " << distance << ", cosine " << along.cosine;
     }
     EXPECT_GT(hits, 10000);
     std::printf("cone (%g, %g, %g, %s) from %g sizes: worst error * cosine = %.2f u\n",

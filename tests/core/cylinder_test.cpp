@@ -331,11 +331,8 @@ long double reference_t(const Cylinder& cylinder, const Ray& ray) {
 }
 
 // Rays from origins `distance` radii away in random directions, aimed at random points of the
-// side (and caps) away from the rims. The error is a distance along the ray relative to the
-// magnitudes involved, |t - t_ref| |d| / (|o| + |t d| + r) (about half the relative t error
-// here, as |o| ~ |t d|). Moving the origin along the line costs a rounding of about 2 u |o| per
-// coordinate, which shifts the hit along the ray by that much over the cosine between ray and
-// normal; the roots and the final addition add a few ulps. Bound: (16 / cos + 8) u.
+// side (and caps) away from the rims. The error is test::AlongRayError (a distance along the
+// ray relative to the magnitudes involved), at most (16 / cos + 8) u.
 void expect_accurate_from_afar(const Cylinder& cylinder, double distance, std::uint64_t seed) {
     test::Random random(seed);
     const Point3 center(0.0, 0.5 * (cylinder.y_min() + cylinder.y_max()), 0.0);
@@ -362,15 +359,11 @@ void expect_accurate_from_afar(const Cylinder& cylinder, double distance, std::u
         ASSERT_EQ(hit.has_value(), std::isfinite(expected)) << "ray " << i;
         if (!hit) continue;
         ++hits;
-        // The surface actually hit (a ray aimed at the side may meet a cap first).
-        const double cosine = std::abs(ray.direction.normalized().dot(hit->geometric_normal));
-        const double magnitude =
-            ray.origin.norm() + std::abs(hit->t) * ray.direction.norm() + cylinder.radius();
-        const double error =
-            static_cast<double>(std::abs(hit->t - expected)) * ray.direction.norm() / magnitude;
-        worst = std::max(worst, error * std::max(cosine, 1e-3) / kUnitRoundoff);
-        EXPECT_LE(error, kUnitRoundoff * (16.0 / std::max(cosine, 1e-3) + 8.0))
-            << "ray " << i << " at " << distance << " radii, cosine " << cosine;
+        const test::AlongRayError along =
+            test::along_ray_error(ray, *hit, expected, cylinder.radius());
+        worst = std::max(worst, along.scaled());
+        EXPECT_LE(along.error, along.bound())
+            << "ray " << i << " at " << distance << " radii, cosine " << along.cosine;
     }
     EXPECT_GT(hits, 15000);
     std::printf("cylinder (%s) from %g radii: worst error * cosine = %.2f u\n",

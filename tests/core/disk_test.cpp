@@ -30,11 +30,8 @@ TEST(Disk, AnalyticHitWithUv) {
 }
 
 TEST(Disk, FromBelowKeepsTheNormal) {
-    const std::optional<Hit> hit = kDisk.intersect(Ray{Point3(0.5, -1, 0), Vector3(0, 1, 0)});
-    ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 2.0);
-    EXPECT_EQ(hit->geometric_normal, Normal3(0, 1, 0));
-    EXPECT_FALSE(hit->front_face);
+    test::expect_hit_from_behind(kDisk, Ray{Point3(0.5, -1, 0), Vector3(0, 1, 0)}, 2.0,
+                                 Normal3(0, 1, 0));
 }
 
 TEST(Disk, RimBelongsToTheDisk) {
@@ -111,12 +108,10 @@ TEST(Disk, MatchesALongDoubleSolve) {
         const Disk disk(random.in_box(Aabb(Point3(-5, -5, -5), Point3(5, 5, 5))),
                         random.unit_vector(), random.uniform(0.5, 3));
         const Ray ray = random.ray_between(test::enlarged(disk.bounds(), 2.0), disk.bounds());
-        const LongVector c = disk.center().cast<long double>();
-        const LongVector n = disk.normal().cast<long double>();
-        const LongVector o = ray.origin.cast<long double>();
-        const LongVector d = ray.direction.cast<long double>();
-        const long double t = (c - o).dot(n) / d.dot(n);
-        const long double squared = (o + t * d - c).squaredNorm();
+        const test::LongPlaneSolve solve =
+            test::long_plane_solve(disk.center(), disk.normal(), ray);
+        const long double t = solve.t;
+        const long double squared = solve.offset().squaredNorm();
         const long double radius_squared = square(disk.radius());
         // Away from the rim by more than double rounding can move a point (1e-9 relative).
         if (std::abs(squared - radius_squared) < 1e-9L * radius_squared) continue;
@@ -127,8 +122,7 @@ TEST(Disk, MatchesALongDoubleSolve) {
         if (!hit) continue;
         ++hits;
         // The plane solve's forward error, as for the plane.
-        EXPECT_NEAR(hit->t, double(t), double(test::plane_solve_bound(c, o, d, n, t)))
-            << "ray " << i;
+        EXPECT_NEAR(hit->t, double(t), double(solve.bound())) << "ray " << i;
     }
     EXPECT_GT(compared, 49000);
     EXPECT_GT(hits, 10000);
@@ -136,9 +130,8 @@ TEST(Disk, MatchesALongDoubleSolve) {
 
 TEST(Disk, PropertiesOnRandomRays) {
     const Disk disk(Point3(0.3, -1.2, 2.0), Normal3(0.2, 1.0, -0.4), 1.7);
-    const test::SurfaceDescription surface{
-        [&](const Point3& p) { return (p - disk.center()).dot(disk.normal()); },
-        [&](const Point3&) { return Vector3(disk.normal()); }, disk.radius(), disk.bounds()};
+    const test::SurfaceDescription surface =
+        test::plane_surface(disk.center(), disk.normal(), disk.radius(), disk.bounds());
     const test::PropertyCounts counts = test::check_shape_properties(disk, surface, 100000, 53);
     EXPECT_EQ(counts.rays, 100000);
     EXPECT_GT(counts.hits, 20000);

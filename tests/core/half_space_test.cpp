@@ -7,6 +7,7 @@
 #include "csgrt/core/error.h"
 #include "csgrt/core/sphere.h"
 #include "csgrt/csg/boolean.h"
+#include "support/leaf_checks.h"
 #include "support/random.h"
 #include "support/shape_properties.h"
 
@@ -51,11 +52,10 @@ TEST(HalfSpace, ParallelRaysAreWhollyInsideOrOutside) {
 }
 
 TEST(HalfSpace, TheNormalPointsOutOfTheSolid) {
-    const std::optional<Hit> hit = kBelow.intersect(Ray{Point3(0, -3, 0), Vector3(0, 1, 0)});
+    // Arriving from inside: back-facing.
+    const std::optional<Hit> hit = test::expect_hit_from_behind(
+        kBelow, Ray{Point3(0, -3, 0), Vector3(0, 1, 0)}, 4.0, Normal3(0, 1, 0));
     ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 4.0);
-    EXPECT_EQ(hit->geometric_normal, Normal3(0, 1, 0));
-    EXPECT_FALSE(hit->front_face);  // arriving from inside
     EXPECT_EQ(hit->shape, &kBelow);
     EXPECT_TRUE(kBelow.contains(Point3(3, 0.999, -7)));
     EXPECT_FALSE(kBelow.contains(Point3(3, 1.001, -7)));

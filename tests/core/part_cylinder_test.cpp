@@ -242,11 +242,10 @@ long double reference_t(const PartCylinder& part, const Ray& ray, long double& m
     return INFINITY;
 }
 
-// Random rays from near and far against the long double reference. The error is measured as
-// a distance along the ray relative to the magnitudes involved, |t - t_ref| |d| / (|o| + |t d|
-// + r): the rounding of the coordinates (and, far away, of moving the origin, ~2 u |o| per
-// coordinate) moves the crossing by that much over the cosine between ray and normal; the
-// cancellation-free roots add a few ulps. Bound: (16 / cos + 8) u.
+// Random rays from near and far against the long double reference. The error is
+// test::AlongRayError: the rounding of the coordinates (and, far away, of moving the origin)
+// over the cosine between ray and normal, plus a few ulps of the cancellation-free roots.
+// Bound: (16 / cos + 8) u.
 void expect_matches_reference(const PartCylinder& part, double distance, std::uint64_t seed) {
     test::Random random(seed);
     int hits = 0;
@@ -267,13 +266,9 @@ void expect_matches_reference(const PartCylinder& part, double distance, std::ui
         ASSERT_EQ(hit.has_value(), std::isfinite(expected)) << "ray " << i << " seed " << seed;
         if (!hit) continue;
         ++hits;
-        const double cosine = std::abs(ray.direction.normalized().dot(hit->geometric_normal));
-        const double magnitude =
-            ray.origin.norm() + std::abs(hit->t) * ray.direction.norm() + part.radius();
-        const double error =
-            static_cast<double>(std::abs(hit->t - expected)) * ray.direction.norm() / magnitude;
-        worst = std::max(worst, error * std::max(cosine, 1e-3) / kUnitRoundoff);
-        EXPECT_LE(error, kUnitRoundoff * (16.0 / std::max(cosine, 1e-3) + 8.0)) << "ray " << i;
+        const test::AlongRayError along = test::along_ray_error(ray, *hit, expected, part.radius());
+        worst = std::max(worst, along.scaled());
+        EXPECT_LE(along.error, along.bound()) << "ray " << i;
         // The hit honours the limits.
         EXPECT_GE(hit->point.y(), part.y_min());
         EXPECT_LE(hit->point.y(), part.y_max());

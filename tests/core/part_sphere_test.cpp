@@ -294,12 +294,8 @@ TEST(PartSphere, PropertiesOnRandomRays) {
          {std::tuple{0.3, 4.0, 0.4, 2.5}, std::tuple{5.0, 8.0, 0.0, 1.2},
           std::tuple{0.0, kTwoPi, kPi / 2, kPi}}) {
         const PartSphere part(Point3(0.3, -1.2, 2.0), 1.7, phi_min, phi_max, theta_min, theta_max);
-        const test::SurfaceDescription surface{
-            [&](const Point3& p) {
-                return (p - part.center()).squaredNorm() - square(part.radius());
-            },
-            [&](const Point3& p) { return Vector3(2.0 * (p - part.center())); }, part.radius(),
-            part.bounds()};
+        const test::SurfaceDescription surface =
+            test::sphere_surface(part.center(), part.radius(), part.bounds());
         const test::PropertyCounts counts = test::check_shape_properties(part, surface, 100000, 83);
         EXPECT_EQ(counts.rays, 100000);
         EXPECT_GT(counts.hits, 20000);

@@ -274,23 +274,11 @@ TEST(PartTorus, RejectsBadParameters) {
 }
 
 TEST(PartTorus, PropertiesOnRandomRays) {
-    // The quartic as the independent surface (tolerance derived in torus_test.cpp).
+    // The whole torus's quartic as the independent surface.
     const PartTorus part(kMajor, kMinor, 0.3, 4.0, 5.0, 8.5);
-    const test::SurfaceDescription surface{
-        [](const Point3& p) {
-            return square(p.squaredNorm() + kMajor * kMajor - kMinor * kMinor) -
-                   4 * kMajor * kMajor * (p.x() * p.x() + p.z() * p.z());
-        },
-        [](const Point3& p) {
-            const double k = 4 * (p.squaredNorm() + kMajor * kMajor - kMinor * kMinor);
-            return Vector3(k * p.x() - 8 * kMajor * kMajor * p.x(), k * p.y(),
-                           k * p.z() - 8 * kMajor * kMajor * p.z());
-        },
-        kMinor, part.bounds()};
-    test::PropertyTolerance tolerance;
-    tolerance.distance_ulps = 6 * kMajor * (kMajor + kMinor) / (kMinor * (kMajor - kMinor)) + 16;
     const test::PropertyCounts counts =
-        test::check_shape_properties(part, surface, 100000, 403, tolerance);
+        test::check_shape_properties(part, test::torus_surface(kMajor, kMinor, part.bounds()),
+                                     100000, 403, test::torus_tolerance(kMajor, kMinor));
     EXPECT_GT(counts.hits, 20000);
 }
 

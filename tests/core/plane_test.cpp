@@ -9,8 +9,6 @@
 namespace csgrt {
 namespace {
 
-using LongVector = Eigen::Matrix<long double, 3, 1>;
-
 const Plane kGround(Point3(0, 1, 0), Normal3(0, 3, 0));
 
 TEST(Plane, AnalyticHitFromAbove) {
@@ -33,11 +31,8 @@ TEST(Plane, ObliquePlaneAndRay) {
 }
 
 TEST(Plane, FromBelowKeepsTheNormalAndIsBackFacing) {
-    const std::optional<Hit> hit = kGround.intersect(Ray{Point3(0, -3, 0), Vector3(0, 1, 0)});
-    ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 4.0);
-    EXPECT_EQ(hit->geometric_normal, Normal3(0, 1, 0));
-    EXPECT_FALSE(hit->front_face);
+    test::expect_hit_from_behind(kGround, Ray{Point3(0, -3, 0), Vector3(0, 1, 0)}, 4.0,
+                                 Normal3(0, 1, 0));
 }
 
 TEST(Plane, PointingAwayMisses) {
@@ -132,26 +127,21 @@ TEST(Plane, MatchesALongDoubleSolve) {
                           random.unit_vector() * random.uniform(0.1, 10));
         const Ray ray = random.ray_between(Aabb(Point3(-20, -20, -20), Point3(20, 20, 20)),
                                            Aabb(Point3(-20, -20, -20), Point3(20, 20, 20)));
-        const LongVector a = plane.point().cast<long double>();
-        const LongVector n = plane.normal().cast<long double>();
-        const LongVector o = ray.origin.cast<long double>();
-        const LongVector d = ray.direction.cast<long double>();
-        const long double expected = (a - o).dot(n) / d.dot(n);
+        const test::LongPlaneSolve solve =
+            test::long_plane_solve(plane.point(), plane.normal(), ray);
         const std::optional<Hit> hit = plane.intersect(ray);
-        ASSERT_EQ(hit.has_value(), expected >= 0) << "ray " << i;
+        ASSERT_EQ(hit.has_value(), solve.t >= 0) << "ray " << i;
         if (!hit) continue;
-        EXPECT_NEAR(hit->t, static_cast<double>(expected),
-                    static_cast<double>(test::plane_solve_bound(a, o, d, n, expected)))
+        EXPECT_NEAR(hit->t, static_cast<double>(solve.t), static_cast<double>(solve.bound()))
             << "ray " << i;
     }
 }
 
 TEST(Plane, PropertiesOnRandomRays) {
     const Plane plane(Point3(0.3, -1.2, 2.0), Normal3(0.2, 1.0, -0.4));
-    const test::SurfaceDescription surface{
-        [&](const Point3& p) { return (p - plane.point()).dot(plane.normal()); },
-        [&](const Point3&) { return Vector3(plane.normal()); }, 2.0,
-        Aabb(plane.point() - Vector3::Constant(2.0), plane.point() + Vector3::Constant(2.0))};
+    const test::SurfaceDescription surface = test::plane_surface(
+        plane.point(), plane.normal(), 2.0,
+        Aabb(plane.point() - Vector3::Constant(2.0), plane.point() + Vector3::Constant(2.0)));
     const test::PropertyCounts counts = test::check_shape_properties(plane, surface, 100000, 17);
     EXPECT_EQ(counts.rays, 100000);
     EXPECT_GT(counts.hits, 30000);

@@ -32,12 +32,9 @@ TEST(Rectangle, AnalyticHitWithUv) {
 TEST(Rectangle, ParallelogramNotItsBoundingRectangle) {
     // corner (1, 1, 1), edges (2, 0, 0) and (1, 0, 2): normal (0, -4, 0) -> -y.
     const Rectangle parallelogram(Point3(1, 1, 1), Vector3(2, 0, 0), Vector3(1, 0, 2));
-    const std::optional<Hit> hit =
-        parallelogram.intersect(Ray{Point3(2.5, 3, 2), Vector3(0, -1, 0)});  // s = t = 1/2
-    ASSERT_TRUE(hit);
-    EXPECT_EQ(hit->t, 2.0);
-    EXPECT_EQ(hit->geometric_normal, Normal3(0, -1, 0));
-    EXPECT_FALSE(hit->front_face);
+    const std::optional<Hit> hit = test::expect_hit_from_behind(
+        parallelogram, Ray{Point3(2.5, 3, 2), Vector3(0, -1, 0)}, 2.0, Normal3(0, -1, 0));
+    ASSERT_TRUE(hit);  // at s = t = 1/2
     EXPECT_EQ(hit->uv, Vector2(0.5, 0.5));
     // Inside the bounding box, outside the parallelogram: s = -0.1 at t = 0.5.
     EXPECT_FALSE(parallelogram.intersect(Ray{Point3(1.3, 3, 2), Vector3(0, -1, 0)}));
@@ -140,9 +137,8 @@ TEST(Rectangle, MatchesALongDoubleLinearSolve) {
 TEST(Rectangle, PropertiesOnRandomRays) {
     const Rectangle rectangle(Point3(0.3, -1.2, 2.0), Vector3(1.5, 0.2, -0.4),
                               Vector3(0.3, 1.1, 0.9));
-    const test::SurfaceDescription surface{
-        [&](const Point3& p) { return (p - rectangle.corner()).dot(rectangle.normal()); },
-        [&](const Point3&) { return Vector3(rectangle.normal()); }, 1.5, rectangle.bounds()};
+    const test::SurfaceDescription surface =
+        test::plane_surface(rectangle.corner(), rectangle.normal(), 1.5, rectangle.bounds());
     const test::PropertyCounts counts =
         test::check_shape_properties(rectangle, surface, 100000, 62);
     EXPECT_EQ(counts.rays, 100000);

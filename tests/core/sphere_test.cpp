@@ -86,12 +86,8 @@ TEST(Sphere, UvFollowsTheBookConvention) {
 
 TEST(Sphere, PropertiesOnRandomRays) {
     const Sphere sphere(Point3(0.3, -1.2, 2.0), 1.7);
-    const test::SurfaceDescription surface{
-        [&](const Point3& p) {
-            return (p - sphere.center()).squaredNorm() - square(sphere.radius());
-        },
-        [&](const Point3& p) { return Vector3(2.0 * (p - sphere.center())); }, sphere.radius(),
-        sphere.bounds()};
+    const test::SurfaceDescription surface =
+        test::sphere_surface(sphere.center(), sphere.radius(), sphere.bounds());
     const test::PropertyCounts counts = test::check_shape_properties(sphere, surface, 100000, 11);
     EXPECT_GT(counts.hits, 30000);
     EXPECT_GT(counts.span_checks, 100000);

@@ -12,6 +12,7 @@
 #include "csgrt/core/instance.h"
 #include "csgrt/core/polynomial.h"
 #include "stress/reference_shapes.h"
+#include "support/leaf_checks.h"
 #include "support/shape_properties.h"
 
 namespace csgrt {
@@ -182,17 +183,9 @@ TEST(Torus, IntervalHonouredAtBothEnds) {
 }
 
 TEST(Torus, InvalidRaysNeverHit) {
-    const double nan = std::nan("");
-    for (const Ray& ray :
-         {Ray{Point3(nan, 0, -5), Vector3(0, 0, 1)}, Ray{Point3(0, 0, -5), Vector3(0, nan, 1)},
-          Ray{Point3(2, 0, -5), Vector3(0, 0, 0)}, Ray{Point3(2, 0, -kInfinity), Vector3(0, 0, 1)},
-          Ray{Point3(2, 0, -5), Vector3(0, 0, kInfinity)},
-          Ray{Point3(2, 0, -5), Vector3(0, 0, 1), nan, kInfinity},
-          Ray{Point3(2, 0, -5), Vector3(0, 0, 1), 5.0, 4.0}}) {
-        EXPECT_FALSE(kTorus.intersect(ray));
-        EXPECT_FALSE(kTorus.occluded(ray));
-        EXPECT_TRUE(kTorus.spans(ray).empty());
-    }
+    // Invalid versions of a ray through the tube and of one through the hole.
+    test::expect_invalid_rays_miss(kTorus, Ray{Point3(2, 0, -5), Vector3(0, 0, 1)});
+    test::expect_invalid_rays_miss(kTorus, Ray{Point3(0, 0, -5), Vector3(0, 0, 1)});
 }
 
 TEST(Torus, RejectsBadParameters) {
@@ -285,30 +278,14 @@ TEST(Torus, PlacedByAnInstance) {
 }
 
 TEST(Torus, PropertiesOnRandomRays) {
-    // Independent description: the quartic itself, evaluated in double. Its own rounding near
-    // the surface is about 12 u (2 R rho)^2 (two terms of that size cancel), and its gradient
-    // there has length 8 R rho r, so it reports a point on the surface as up to
-    // 12 u 4 R^2 rho^2 / (8 R rho r) = 6 u R rho / r <= 6 u R (R + r) / r away. The check
-    // allows distance_ulps u (|o| + |t d| + scale) with |o| + |t d| >= R - r, so distance_ulps
-    // = 6 R (R + r) / (r (R - r)) + 16 (the projected hit point's own few ulps) covers it.
+    // Independent description: the quartic itself, evaluated in double, with the tolerance its
+    // rounding needs (derived at torus_tolerance).
     for (const double minor : {0.5, 0.05}) {
         const double major = 2.0;
         const Torus torus(major, minor);
-        const test::SurfaceDescription surface{
-            [&](const Point3& p) {
-                return square(p.squaredNorm() + major * major - minor * minor) -
-                       4 * major * major * (p.x() * p.x() + p.z() * p.z());
-            },
-            [&](const Point3& p) {
-                const double k = 4 * (p.squaredNorm() + major * major - minor * minor);
-                return Vector3(k * p.x() - 8 * major * major * p.x(), k * p.y(),
-                               k * p.z() - 8 * major * major * p.z());
-            },
-            minor, torus.bounds()};
-        test::PropertyTolerance tolerance;
-        tolerance.distance_ulps = 6 * major * (major + minor) / (minor * (major - minor)) + 16;
         const test::PropertyCounts counts =
-            test::check_shape_properties(torus, surface, 100000, 13, tolerance);
+            test::check_shape_properties(torus, test::torus_surface(major, minor, torus.bounds()),
+                                         100000, 13, test::torus_tolerance(major, minor));
         EXPECT_GT(counts.hits, minor > 0.1 ? 30000 : 5000);
         EXPECT_GT(counts.span_checks, 100000);
     }

@@ -355,9 +355,8 @@ TEST(Triangle, NeedleTrianglesStillHit) {
 
 TEST(Triangle, PropertiesOnRandomRays) {
     const Triangle triangle(Point3(0.3, -1.2, 2.0), Point3(2.1, 0.4, 1.1), Point3(-0.7, 1.5, 0.2));
-    const test::SurfaceDescription surface{
-        [&](const Point3& p) { return (p - triangle.vertex(0)).dot(triangle.normal()); },
-        [&](const Point3&) { return Vector3(triangle.normal()); }, 2.0, triangle.bounds()};
+    const test::SurfaceDescription surface =
+        test::plane_surface(triangle.vertex(0), triangle.normal(), 2.0, triangle.bounds());
     const test::PropertyCounts counts = test::check_shape_properties(triangle, surface, 100000, 37);
     EXPECT_EQ(counts.rays, 100000);
     EXPECT_GT(counts.hits, 20000);

@@ -19,6 +19,7 @@
 #include "csgrt/csg/painted.h"
 #include "csgrt/mesh/mesh.h"
 #include "support/meshes.h"
+#include "support/precisions.h"
 #include "support/random.h"
 #include "support/rays.h"
 
@@ -132,8 +133,7 @@ BatchConfig threads(int count) {
 
 template <class Real>
 class BatchTest : public ::testing::Test {};
-using Precisions = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(BatchTest, Precisions);
+TYPED_TEST_SUITE(BatchTest, test::Precisions);
 
 TYPED_TEST(BatchTest, SceneNearestHitsAreTheSingleRayAnswersForEveryThreadCount) {
     using Real = TypeParam;

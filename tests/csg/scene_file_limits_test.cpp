@@ -16,29 +16,11 @@
 #include "csgrt/csg/compound.h"
 #include "csgrt/csg/scene_file.h"
 #include "support/scene_error.h"
+#include "support/scene_texts.h"
 #include "support/test_scale.h"
 
 namespace csgrt {
 namespace {
-
-/// d0 is a unit sphere; d_k = compound [d_{k-1}, d_{k-1} moved along x by `offset`, times
-/// 2^(k-1) when `growing` (then no two copies share a place)].
-std::string doubling(int levels, double offset, bool growing = false) {
-    std::string text = R"({"definitions": {"d0": {"type": "sphere", "radius": 1})";
-    for (int k = 1; k <= levels; ++k) {
-        // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on chained string +.
-        const std::string below = std::string("d").append(std::to_string(k - 1));
-        text.append(", \"d").append(std::to_string(k));
-        text.append(R"(": {"type": "compound", "children": [{"type": "ref", "definition": ")");
-        text.append(below).append(R"("}, {"type": "ref", "definition": ")").append(below);
-        char moved[32];
-        std::snprintf(moved, sizeof moved, "%.17g", growing ? std::ldexp(offset, k - 1) : offset);
-        text.append(R"(", "transform": [{"translate": [)").append(moved).append(", 0, 0]}]}]}");
-    }
-    return text.append(R"(}, "objects": [{"type": "ref", "definition": "d)")
-        .append(std::to_string(levels))
-        .append("\"}]}");
-}
 
 TEST(SceneFileLimits, ALegalChainOfTwentyThousandRefsLoadsWhereItPutsTheSphere) {
     // d_k = d_{k-1} moved by 1/1024 (exact in binary, so the folded sum is exact): 20,000
@@ -63,7 +45,7 @@ TEST(SceneFileLimits, ALegalChainOfTwentyThousandRefsLoadsWhereItPutsTheSphere) 
 
 TEST(SceneFileLimits, ExactlyCoincidentCopiesCostOneTest) {
     // 2^20 copies of one sphere in one place (the transform a zero translation).
-    Scene scene = load_scene_from_string(doubling(20, 0.0), "test.json");
+    Scene scene = load_scene_from_string(test::doubling_scene(20, 0.0), "test.json");
     const auto& top = dynamic_cast<const Compound&>(*scene.objects().front().shape);
     // Each compound keeps one of its two equal children.
     EXPECT_EQ(top.accelerator_stats().primitives, 1u);
@@ -76,17 +58,18 @@ TEST(SceneFileLimits, ExactlyCoincidentCopiesCostOneTest) {
 
 TEST(SceneFileLimits, APileOfNearlyCoincidentCopiesIsRefusedAtItsDefinition) {
     // 2^13 copies a nanometre apart load; d14 has 2^14 > 10,000 and is named.
-    EXPECT_EQ(test::scene_error_of(doubling(13, 1e-9)), "no error");
-    const std::string message = test::scene_error_of(doubling(20, 1e-9));
+    EXPECT_EQ(test::scene_error_of(test::doubling_scene(13, 1e-9)), "no error");
+    const std::string message = test::scene_error_of(test::doubling_scene(20, 1e-9));
     EXPECT_NE(message.find("test.json: /definitions/d14: about 16384 leaf shapes overlap at one "
                            "point"),
               std::string::npos)
         << message;
     // Moved by more than their size, the copies are no pile: 2^20 spheres side by side.
-    EXPECT_EQ(test::scene_error_of(doubling(20, 2.5, true)), "no error");
+    EXPECT_EQ(test::scene_error_of(test::doubling_scene(20, 2.5, true)), "no error");
     // But equal moves at every level pile C(k, j) copies at j * 2.5, C(16, 8) = 12870 at d16
     // (the estimate, which adds up overlapping children, says 2^14 there).
-    EXPECT_NE(test::scene_error_of(doubling(20, 2.5)).find("/definitions/d16: about 16384 leaf shapes"),
+    EXPECT_NE(test::scene_error_of(test::doubling_scene(20, 2.5))
+                  .find("/definitions/d16: about 16384 leaf shapes"),
               std::string::npos);
 }
 

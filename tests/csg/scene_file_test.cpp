@@ -16,6 +16,8 @@
 #include "csgrt/csg/compound.h"
 #include "support/random.h"
 #include "support/scene_error.h"
+#include "support/scene_texts.h"
+#include "support/test_output.h"
 
 namespace csgrt {
 namespace {
@@ -343,10 +345,7 @@ TEST(SceneFile, MutatedScenesLoadOrGiveASceneError) {
     const std::string alphabet = "{}[],:\"-+.0123456789eEtrufalsn xyz_/";
     int loaded = 0, rejected = 0;
     for (const char* name : {"showcase.json", "part_objects.json"}) {
-        std::ifstream file(kScenes / name);
-        std::ostringstream buffer;
-        buffer << file.rdbuf();
-        const std::string original = buffer.str();
+        const std::string original = test::file_contents(kScenes / name);
         ASSERT_GT(original.size(), 1000u);
         for (int i = 0; i < 600; ++i) {
             std::string text = original;
@@ -439,25 +438,9 @@ TEST(SceneFile, AChainOfHundredThousandRefsIsCutAtTheShapeDepthLimit) {
         << message.substr(0, 300);
 }
 
-/// Definitions d0 (a sphere) and d_k = compound [d_{k-1}, d_{k-1}]: d_k expands to 2^k spheres
-/// in about 60 bytes per level.
-std::string doubling_definitions(int levels, int used) {
-    std::string text = R"({"definitions": {"d0": {"type": "sphere", "radius": 1})";
-    for (int k = 1; k <= levels; ++k) {
-        const std::string below = std::string("d").append(std::to_string(k - 1));
-        // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on chained string +.
-        text.append(", \"d").append(std::to_string(k));
-        text.append(R"(": {"type": "compound", "children": [{"type": "ref", "definition": ")");
-        text.append(below).append(R"("}, {"type": "ref", "definition": ")").append(below);
-        text.append(R"("}]})");
-    }
-    text.append(R"(}, "objects": [{"type": "ref", "definition": "d)");
-    return text.append(std::to_string(used)).append("\"}]}");
-}
-
 TEST(SceneFile, ExpandedLeavesAreCountedOnceEachAndCapped) {
     // 2^64 leaves in 8 KB: refused at the object that passes 10^7, with the saturated count.
-    const std::string text = doubling_definitions(64, 64);
+    const std::string text = test::doubling_scene(64);
     ASSERT_LT(text.size(), 8000u);
     const std::string message = test::scene_error_of(text);
     EXPECT_NE(message.find("test.json: /objects/0: the scene expands to at least 2^64 - 1 leaf "
@@ -465,10 +448,11 @@ TEST(SceneFile, ExpandedLeavesAreCountedOnceEachAndCapped) {
               std::string::npos)
         << message;
     // 2^23 = 8,388,608 leaves is within the limit; 2^24 is not.
-    EXPECT_NE(test::scene_error_of(doubling_definitions(24, 24)).find("expands to 16777216 leaf shapes"),
-              std::string::npos);
+    EXPECT_NE(
+        test::scene_error_of(test::doubling_scene(24)).find("expands to 16777216 leaf shapes"),
+        std::string::npos);
     // The count info reports, against the closed form: 2^20 spheres under 2^20 - 1 compounds.
-    const Scene scene = load(doubling_definitions(20, 20));
+    const Scene scene = load(test::doubling_scene(20));
     const SceneShapeCounts counts = count_scene_shapes(scene);
     EXPECT_EQ(counts.leaves, 1u << 20);
     EXPECT_EQ(counts.by_kind.at("sphere"), 1u << 20);

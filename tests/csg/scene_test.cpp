@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <thread>
 
@@ -17,6 +16,7 @@
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/compound.h"
 #include "support/random.h"
+#include "support/test_output.h"
 
 namespace csgrt {
 namespace {
@@ -82,16 +82,9 @@ TEST(Scene, DocsExampleBuildsAndHitsTheNearestBall) {
     EXPECT_NEAR(scene.bounds().upper.y(), 2.0, 1e-12);
 }
 
-std::string read_file(const std::filesystem::path& path) {
-    std::ifstream file(path);
-    std::ostringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
-
 TEST(Scene, DocsShowTheExampleVerbatim) {
     const std::filesystem::path root(CSGRT_SOURCE_DIR);
-    const std::string source = read_file(root / "tests" / "csg" / "scene_test.cpp");
+    const std::string source = test::file_contents(root / "tests" / "csg" / "scene_test.cpp");
     const std::string begin_marker = "// docs-example-begin\n";
     const auto begin = source.find(begin_marker) + begin_marker.size();
     const auto end = source.rfind("\n", source.find("    // docs-example-end")) + 1;
@@ -100,7 +93,7 @@ TEST(Scene, DocsShowTheExampleVerbatim) {
     std::string example, line;
     while (std::getline(lines, line)) example += (line.size() >= 4 ? line.substr(4) : line) + "\n";
     ASSERT_GT(example.size(), 500u);
-    EXPECT_NE(read_file(root / "docs" / "scene.md").find("```cpp\n" + example + "```"),
+    EXPECT_NE(test::file_contents(root / "docs" / "scene.md").find("```cpp\n" + example + "```"),
               std::string::npos)
         << "docs/scene.md does not show the example of scene_test.cpp:\n"
         << example;

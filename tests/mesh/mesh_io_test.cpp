@@ -12,10 +12,11 @@
 #include <set>
 #include <sstream>
 
-#include "csgrt/mesh/mesh_tools.h"
 #include "csgrt/core/error.h"
+#include "csgrt/mesh/mesh_tools.h"
 #include "support/meshes.h"
 #include "support/real_meshes.h"
+#include "support/test_output.h"
 
 namespace csgrt {
 namespace {
@@ -254,11 +255,6 @@ std::string mesh_error(const std::filesystem::path& path) {
     return "no error";
 }
 
-std::string read_text(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 TEST(MeshIo, FifosDevicesAndNulBytesAreRefusedBeforeOpening) {
     // Opening a FIFO would block until a writer came, and a device never ends: both are
     // refused from the file's status alone, so this test returns at once.
@@ -286,21 +282,29 @@ TEST(MeshIo, ALineLongerThanOneMebibyteIsRefusedWithoutReadingTheRest) {
     EXPECT_NE(message.find("line 2: longer than 1048576 bytes"), std::string::npos) << message;
 }
 
-TEST(MeshIo, PlyFormatVersionOneWithoutDecimalsLoadsAsTheToolsReadIt) {
-    // "format ascii 1" is what some exporters write; OpenMesh and assimp read it as 1.0.
-    ScratchFolder folder;
-    std::string text = read_text(kFixtures / "box_ascii.ply");
-    const std::size_t at = text.find("format ascii 1.0");
-    ASSERT_NE(at, std::string::npos);
-    text.replace(at, 16, "format ascii 1");
-    const std::filesystem::path path = folder.path() / "box.ply";
+/// Writes `text` to `path` and checks that it loads as the fixture box_ascii.ply does: the same
+/// vertices, triangles and face count (`label` names the case). Returns the load's report.
+MeshReport expect_loads_as_the_ply_box(const std::string& text, const std::filesystem::path& path,
+                                       const std::string& label) {
     std::ofstream(path, std::ios::binary) << text;
     MeshReport report, reference;
     const TriangleMeshData mesh = load_mesh(path, &report);
     const TriangleMeshData expected = load_mesh(kFixtures / "box_ascii.ply", &reference);
-    EXPECT_EQ(mesh.vertices, expected.vertices);
-    EXPECT_EQ(mesh.triangles, expected.triangles);
-    EXPECT_EQ(report.faces, reference.faces);
+    EXPECT_EQ(mesh.vertices, expected.vertices) << label;
+    EXPECT_EQ(mesh.triangles, expected.triangles) << label;
+    EXPECT_EQ(report.faces, reference.faces) << label;
+    return report;
+}
+
+TEST(MeshIo, PlyFormatVersionOneWithoutDecimalsLoadsAsTheToolsReadIt) {
+    // "format ascii 1" is what some exporters write; OpenMesh and assimp read it as 1.0.
+    ScratchFolder folder;
+    std::string text = test::file_contents(kFixtures / "box_ascii.ply");
+    const std::size_t at = text.find("format ascii 1.0");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 16, "format ascii 1");
+    const std::filesystem::path path = folder.path() / "box.ply";
+    expect_loads_as_the_ply_box(text, path, "format ascii 1");
     // Other versions stay refused: the format has only 1.0.
     text.replace(at, 14, "format ascii 2");
     std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
@@ -311,21 +315,15 @@ TEST(MeshIo, PlyHeaderLinesTheToolsTolerateLoadAsTheFixture) {
     // What exporters write and OpenMesh and assimp read (docs/meshes.md): obj_info and
     // comment lines anywhere in the header, blank header lines, CRLF line ends throughout.
     ScratchFolder folder;
-    std::istringstream lines(read_text(kFixtures / "box_ascii.ply"));
+    std::istringstream lines(test::file_contents(kFixtures / "box_ascii.ply"));
     std::string text;
     for (std::string line; std::getline(lines, line);) {
         text += line + "\r\n";
         if (line.rfind("format ", 0) == 0) text += "obj_info written by a test\r\n\r\n";
         if (line.rfind("element face", 0) == 0) text += "comment between elements\r\n";
     }
-    const std::filesystem::path path = folder.path() / "box.ply";
-    std::ofstream(path, std::ios::binary) << text;
-    MeshReport report, reference;
-    const TriangleMeshData mesh = load_mesh(path, &report);
-    const TriangleMeshData expected = load_mesh(kFixtures / "box_ascii.ply", &reference);
-    EXPECT_EQ(mesh.vertices, expected.vertices);
-    EXPECT_EQ(mesh.triangles, expected.triangles);
-    EXPECT_EQ(report.faces, reference.faces);
+    const MeshReport report =
+        expect_loads_as_the_ply_box(text, folder.path() / "box.ply", "tolerated header lines");
     EXPECT_TRUE(report.is_closed);
 }
 
@@ -333,7 +331,7 @@ TEST(MeshIo, AsciiStlWithSeveralSolidsIsOneMesh) {
     // The fixture's 12 facets, then the same box moved by 10 in x as a second solid: 24
     // triangles, two closed components, as exporters write several parts.
     ScratchFolder folder;
-    const std::string box = read_text(kFixtures / "box_ascii.stl");
+    const std::string box = test::file_contents(kFixtures / "box_ascii.stl");
     std::string moved;
     std::istringstream lines(box);
     for (std::string line; std::getline(lines, line);) {

@@ -66,8 +66,7 @@ void expect_agreement_with_brute_force(const Mesh& mesh, int rays, std::uint64_t
     const Aabb box = mesh.bounds();
     int hits = 0;
     for (int i = 0; i < rays; ++i) {
-        Ray ray = random.ray_between(test::enlarged(box, 1.0), box);
-        if (i % 4 == 0) ray.origin = random.in_box(box);
+        Ray ray = test::ray_toward(random, box, i);
         HitRecord expected, found;
         const bool expected_hit = brute.intersect(ray, expected, scratch);
         const bool hit = mesh.nearest_hit(ray, found, scratch);

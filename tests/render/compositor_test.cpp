@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
@@ -58,13 +57,6 @@ std::string run(const std::string& command) {
     return output;
 }
 
-std::string bytes_of(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
-
 /// The rendered test scene, with an id beyond float's exact integers (2^24 + 1) written into
 /// one pixel, so a reader that turned ids into floats would be caught.
 Image rendered_image() {
@@ -83,6 +75,19 @@ ExrMetadata metadata_of(const Scene& scene) {
     metadata.objects = exr_objects(scene);
     metadata.scene = "spheres.json";
     return metadata;
+}
+
+/// Writes `image`, with the metadata of the test scene, to out.exr in a fresh directory
+/// test_output/`directory_name`: the file given to OpenImageIO's tools. Returns its path.
+fs::path written_exr(const std::string& directory_name, const Image& image) {
+    const fs::path path = fresh_directory(directory_name) / "out.exr";
+    write_exr(path, image, metadata_of(test::spheres_on_a_plane()));
+    return path;
+}
+
+/// Why a test that needs OpenImageIO's `tool` skips without it.
+std::string not_installed(const std::string& tool) {
+    return tool + " not installed (openimageio-tools; scripts/bootstrap)";
 }
 
 /// oiiotool --dumpdata's pixel lines, per subimage: "Pixel (x, y): v0 v1 ..." -> values as text.
@@ -140,19 +145,17 @@ TEST(Compositor, IdenticalRendersGiveByteIdenticalFiles) {
         write_render_files(directory / name, result.image, metadata);
     }
     for (const char* suffix : {".exr", ".png", ".cost.png"}) {
-        const std::string a = bytes_of(directory / (std::string("a") + suffix));
+        const std::string a = test::file_contents(directory / (std::string("a") + suffix));
         ASSERT_FALSE(a.empty()) << suffix;
-        EXPECT_TRUE(a == bytes_of(directory / (std::string("b") + suffix))) << suffix;
+        EXPECT_TRUE(a == test::file_contents(directory / (std::string("b") + suffix))) << suffix;
     }
 }
 
 TEST(Compositor, OpenImageIoListsTheChannelsWithTheirTypes) {
     const fs::path iinfo = find_tool("iinfo");
-    if (iinfo.empty()) GTEST_SKIP() << "iinfo not installed (openimageio-tools; scripts/bootstrap)";
-    const fs::path directory = fresh_directory("compositor_iinfo");
-    Scene scene = test::spheres_on_a_plane();
-    write_exr(directory / "out.exr", rendered_image(), metadata_of(scene));
-    const std::string info = run(iinfo.string() + " -v -a " + (directory / "out.exr").string());
+    if (iinfo.empty()) GTEST_SKIP() << not_installed("iinfo");
+    const fs::path exr = written_exr("compositor_iinfo", rendered_image());
+    const std::string info = run(iinfo.string() + " -v -a " + exr.string());
     for (const char* expected :
          {"2 subimages",
           "channel list: R (half), G (half), B (half), A (half), Z (float), N.X (float), "
@@ -167,14 +170,10 @@ TEST(Compositor, OpenImageIoListsTheChannelsWithTheirTypes) {
 
 TEST(Compositor, OpenImageIoReadsEveryPixelAsWritten) {
     const fs::path oiiotool = find_tool("oiiotool");
-    if (oiiotool.empty()) {
-        GTEST_SKIP() << "oiiotool not installed (openimageio-tools; scripts/bootstrap)";
-    }
-    const fs::path directory = fresh_directory("compositor_oiiotool");
+    if (oiiotool.empty()) GTEST_SKIP() << not_installed("oiiotool");
     const Image image = rendered_image();
-    write_exr(directory / "out.exr", image, metadata_of(test::spheres_on_a_plane()));
-    const auto subimages = dumped_pixels(
-        run(oiiotool.string() + " -a --dumpdata " + (directory / "out.exr").string()));
+    const fs::path exr = written_exr("compositor_oiiotool", image);
+    const auto subimages = dumped_pixels(run(oiiotool.string() + " -a --dumpdata " + exr.string()));
     ASSERT_EQ(subimages.size(), 2u);
     ASSERT_EQ(subimages[0].size(), image.pixel_count());
     ASSERT_EQ(subimages[1].size(), image.pixel_count());
@@ -224,17 +223,14 @@ TEST(Compositor, OpenImageIoReadsEveryPixelAsWritten) {
 
 TEST(Compositor, AnOpenImageIoCopyReadsBackTheSamePixels) {
     const fs::path oiiotool = find_tool("oiiotool");
-    if (oiiotool.empty()) {
-        GTEST_SKIP() << "oiiotool not installed (openimageio-tools; scripts/bootstrap)";
-    }
-    const fs::path directory = fresh_directory("compositor_copy");
+    if (oiiotool.empty()) GTEST_SKIP() << not_installed("oiiotool");
     const Image image = rendered_image();
-    write_exr(directory / "out.exr", image, metadata_of(test::spheres_on_a_plane()));
+    const fs::path exr = written_exr("compositor_copy", image);
+    const fs::path copied = exr.parent_path() / "copy.exr";
     // --native: without it oiiotool's image cache holds every part as float, and ids above
     // 2^24 come back rounded (docs/rendering.md).
-    run(oiiotool.string() + " --native -a " + (directory / "out.exr").string() + " -o " +
-        (directory / "copy.exr").string());
-    const ExrFile copy = read_exr(directory / "copy.exr");
+    run(oiiotool.string() + " --native -a " + exr.string() + " -o " + copied.string());
+    const ExrFile copy = read_exr(copied);
     ASSERT_EQ(copy.image.width(), image.width());
     ASSERT_EQ(copy.image.height(), image.height());
     for (std::size_t i = 0; i < image.pixel_count(); ++i) {

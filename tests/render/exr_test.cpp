@@ -262,12 +262,6 @@ TEST(WriteExr, TheIdManifestNamesEveryObject) {
 
 TEST(WriteExr, IdenticalImagesGiveByteIdenticalFilesWithoutTimings) {
     const auto directory = fresh_directory("exr_identical");
-    auto bytes = [](const std::filesystem::path& path) {
-        std::ifstream in(path, std::ios::binary);
-        std::ostringstream text;
-        text << in.rdbuf();
-        return text.str();
-    };
     ExrMetadata metadata = sample_metadata();
     metadata.include_timing = false;
     metadata.accelerator_build_milliseconds = 1.0;
@@ -275,9 +269,9 @@ TEST(WriteExr, IdenticalImagesGiveByteIdenticalFilesWithoutTimings) {
     metadata.accelerator_build_milliseconds = 2.0;  // a different timing: not in the file
     metadata.render_seconds = 7.0;
     write_exr(directory / "b.exr", sample_image(), metadata);
-    const std::string a = bytes(directory / "a.exr");
+    const std::string a = test::file_contents(directory / "a.exr");
     EXPECT_GT(a.size(), 100u);
-    EXPECT_EQ(a, bytes(directory / "b.exr"));
+    EXPECT_EQ(a, test::file_contents(directory / "b.exr"));
     Imf::InputFile file((directory / "a.exr").c_str());
     EXPECT_TRUE(file.header().find("acceleratorBuildMs") == file.header().end());
     EXPECT_TRUE(file.header().find("renderSeconds") == file.header().end());

@@ -146,17 +146,33 @@ TEST(Render, EveryPixelsIdDepthAndNormalMatchAnAnalyticTraceOfTheSpheres) {
     }
 }
 
-TEST(Render, LambertShadingOfPointAndDirectionalLightsMatchesTheFormula) {
+/// The unit sphere at the origin in one material of colour `albedo`, seen by the default camera
+/// from (0, 0, `distance`): the centre pixel shows the point (0, 0, 1), facing the camera. Not
+/// committed, so a test can still add lights.
+Scene unit_sphere_seen_from(double distance, const Vector3& albedo) {
     Scene scene;
-    const Vector3 albedo(0.6, 0.5, 0.25);
     scene.add_object(std::make_shared<Sphere>(Point3(0, 0, 0), 1.0),
                      scene.add_material(Material{"m", albedo}));
+    Camera camera;
+    camera.position = Point3(0, 0, distance);
+    scene.set_camera(camera);
+    return scene;
+}
+
+/// `pixel`'s colour is `expected` to the rounding of its half storage (2^-11 relative), doubled;
+/// `label` names the pixel.
+void expect_half_colour(const Pixel& pixel, const Vector3& expected, const char* label) {
+    EXPECT_NEAR(pixel.red, expected.x(), expected.x() * 0x1.0p-10) << label;
+    EXPECT_NEAR(pixel.green, expected.y(), expected.y() * 0x1.0p-10) << label;
+    EXPECT_NEAR(pixel.blue, expected.z(), expected.z() * 0x1.0p-10) << label;
+}
+
+TEST(Render, LambertShadingOfPointAndDirectionalLightsMatchesTheFormula) {
+    const Vector3 albedo(0.6, 0.5, 0.25);
+    Scene scene = unit_sphere_seen_from(5.0, albedo);
     const Vector3 intensity(40, 30, 20), radiance(0.5, 1.0, 1.5);
     scene.add_light(PointLight{Point3(2, 3, 4), intensity});
     scene.add_light(DirectionalLight{Vector3(0, 0, -2), radiance});
-    Camera camera;
-    camera.position = Point3(0, 0, 5);
-    scene.set_camera(camera);
     scene.commit();
     const RenderResult result = render(scene, test::settings_of_size(31, 31));
     // Centre pixel: the hit is (0, 0, 1) with normal +z. The point light is at distance^2 22
@@ -164,10 +180,7 @@ TEST(Render, LambertShadingOfPointAndDirectionalLightsMatchesTheFormula) {
     const Vector3 expected =
         albedo.cwiseProduct(intensity / 22.0 * (3.0 / std::sqrt(22.0)) + radiance) / kPi;
     const Pixel& pixel = result.image.at(15, 15);
-    // Colour is stored as half: 2^-11 relative rounding, doubled.
-    EXPECT_NEAR(pixel.red, expected.x(), expected.x() * 0x1.0p-10);
-    EXPECT_NEAR(pixel.green, expected.y(), expected.y() * 0x1.0p-10);
-    EXPECT_NEAR(pixel.blue, expected.z(), expected.z() * 0x1.0p-10);
+    expect_half_colour(pixel, expected, "centre pixel");
     EXPECT_EQ(pixel.alpha, 1.0f);
     // Both lights face every visible point near the centre; all get two shadow rays, fewer
     // near the rim, where the lights are behind the surface.
@@ -211,13 +224,8 @@ TEST(Render, HardShadowOfASphereOnAPlaneIsExactlyWhereTheSphereBlocksTheLight) {
 }
 
 TEST(Render, ASceneWithoutLightsIsLitFromTheEyeAndCastsNoShadowRays) {
-    Scene scene;
     const Vector3 albedo(0.3, 0.6, 0.9);
-    scene.add_object(std::make_shared<Sphere>(Point3(0, 0, 0), 1.0),
-                     scene.add_material(Material{"m", albedo}));
-    Camera camera;
-    camera.position = Point3(0, 0, 4);
-    scene.set_camera(camera);
+    Scene scene = unit_sphere_seen_from(4.0, albedo);
     scene.commit();
     const RenderResult result = render(scene, test::settings_of_size(21, 21, 4));
     EXPECT_EQ(result.stats.shadow_rays, 0u);
@@ -233,9 +241,7 @@ TEST(Render, ASceneWithoutLightsIsLitFromTheEyeAndCastsNoShadowRays) {
     // With one sample, the centre ray is on the axis: exactly the albedo (half-rounded).
     // A copy: the RenderResult is a temporary that dies at the end of this statement.
     const Pixel centre = render(scene, test::settings_of_size(21, 21, 1)).image.at(10, 10);
-    EXPECT_NEAR(centre.red, albedo.x(), albedo.x() * 0x1.0p-10);
-    EXPECT_NEAR(centre.green, albedo.y(), albedo.y() * 0x1.0p-10);
-    EXPECT_NEAR(centre.blue, albedo.z(), albedo.z() * 0x1.0p-10);
+    expect_half_colour(centre, albedo, "centre pixel, one sample");
 }
 
 TEST(Render, CountsPrimaryAndShadowRays) {

@@ -41,13 +41,6 @@ Transform placement_at(double scale) {
            Transform::rotate(Vector3(1, 2, 3), 0.7) * Transform::scale(scale);
 }
 
-/// Random rays toward `box`: from outside, and from inside it every fourth ray.
-Ray ray_toward(test::Random& random, const Aabb& box, int i) {
-    Ray ray = random.ray_between(test::enlarged(box, 1.0), box);
-    if (i % 4 == 0) ray.origin = random.in_box(box);
-    return ray;
-}
-
 std::vector<std::pair<std::string, ShapePointer>> unit_solids() {
     auto unit_sphere = std::make_shared<Sphere>(Point3(0, 0, 0), 1.0);
     TriangleMeshData octahedron{test::sphere_mesh(3).vertices, test::sphere_mesh(3).triangles, {}};
@@ -80,7 +73,7 @@ TEST(CsgStress, CoincidentOperandsAtEveryScale) {
             const Boolean both(BooleanOperation::Union, a, a);
             const Boolean common(BooleanOperation::Intersection, a, a);
             for (int i = 0; i < rays; ++i) {
-                const Ray ray = ray_toward(random, a->bounds(), i);
+                const Ray ray = test::ray_toward(random, a->bounds(), i);
                 ++total;
                 const std::optional<Hit> hit = a->intersect(ray);
                 hits += hit ? 1 : 0;
@@ -146,7 +139,7 @@ TEST(CsgStress, BoxesTilingABoxAreThatBox) {
         const Box bottom(corner(0, 0, 0), corner(3, 2, 3));
         long hits = 0, along_planes = 0;
         for (int i = 0; i < rays; ++i) {
-            Ray ray = ray_toward(random, whole.bounds(), i);
+            Ray ray = test::ray_toward(random, whole.bounds(), i);
             if (i % 8 == 1) {
                 // Along an internal plane: origin on the plane x = planes[1].x, direction in it.
                 ray.origin.x() = planes[1].x();
@@ -403,7 +396,7 @@ TEST(CsgStress, DeepTreesAgreeWithPointMembership) {
         ASSERT_FALSE(box.is_empty());
         const Long band = 1e-9L * scale;
         for (int i = 0; i < rays; ++i) {
-            Ray ray = ray_toward(random, box, i);
+            Ray ray = test::ray_toward(random, box, i);
             if (i % 2) {
                 // Toward a leaf's centre: the box of a long chain is mostly empty.
                 const ModelLeaf& leaf = model.leaves[i / 2 % model.leaves.size()];

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <optional>
@@ -24,6 +25,56 @@ long double plane_solve_bound(const Vector& a, const Vector& o, const Vector& d,
                                    std::abs(t) * d.cwiseAbs().dot(n.cwiseAbs())) /
                                   std::abs(d.dot(n));
     return gamma(6) * magnitude;
+}
+
+/// A flat shape's plane solve done in long double from its double inputs (anchor a, unit normal
+/// n, ray o + t d): t = ((a - o) . n) / (d . n), the reference the double solve is held to.
+struct LongPlaneSolve {
+    using Vector = Eigen::Matrix<long double, 3, 1>;
+    Vector a, n, o, d;
+    long double t = 0;
+
+    /// The point of the line at t, relative to the anchor.
+    Vector offset() const { return o + t * d - a; }
+    /// plane_solve_bound at t: how far from t the double solve may land.
+    long double bound() const { return plane_solve_bound(a, o, d, n, t); }
+};
+
+/// The LongPlaneSolve of `ray` against the plane through `anchor` with unit normal `normal`.
+inline LongPlaneSolve long_plane_solve(const Point3& anchor, const Normal3& normal,
+                                       const Ray& ray) {
+    LongPlaneSolve solve{anchor.cast<long double>(), normal.cast<long double>(),
+                         ray.origin.cast<long double>(), ray.direction.cast<long double>()};
+    solve.t = (solve.a - solve.o).dot(solve.n) / solve.d.dot(solve.n);
+    return solve;
+}
+
+/// A hit's t against a reference t, as a distance along the ray relative to the magnitudes
+/// involved: |t - t_ref| |d| / (|o| + |t d| + size) (about half the relative t error when
+/// |o| ~ |t d|). Moving the origin along the line costs a rounding of about 2 u |o| per
+/// coordinate, which shifts the hit along the ray by that much over the cosine between ray and
+/// normal; the roots and the final addition add a few ulps. Hence the bound (16 / cos + 8) u.
+struct AlongRayError {
+    double error = 0.0;
+    /// |cos| of the angle between the ray and the normal of the surface actually hit (a ray
+    /// aimed at one surface may meet another first).
+    double cosine = 0.0;
+
+    /// (16 / cos + 8) u, the cosine taken as at least 1e-3.
+    double bound() const { return kUnitRoundoff * (16.0 / std::max(cosine, 1e-3) + 8.0); }
+    /// The error times the cosine, in units of u: what the accuracy tests print as their worst.
+    double scaled() const { return error * std::max(cosine, 1e-3) / kUnitRoundoff; }
+};
+
+/// The AlongRayError of `hit` on `ray` against the reference t `expected`, for a shape `size`
+/// across (its radius, or its largest dimension).
+inline AlongRayError along_ray_error(const Ray& ray, const Hit& hit, long double expected,
+                                     double size) {
+    const double cosine = std::abs(ray.direction.normalized().dot(hit.geometric_normal));
+    const double magnitude = ray.origin.norm() + std::abs(hit.t) * ray.direction.norm() + size;
+    const double error =
+        static_cast<double>(std::abs(hit.t - expected)) * ray.direction.norm() / magnitude;
+    return {error, cosine};
 }
 
 /// Invalid versions of the valid ray `valid`: each origin and each direction component made NaN,
@@ -87,6 +138,20 @@ inline void expect_misses(const Shape& shape, std::initializer_list<Ray> rays) {
         EXPECT_FALSE(shape.intersect(ray)) << shape.kind();
         EXPECT_FALSE(shape.occluded(ray)) << shape.kind();
     }
+}
+
+/// `ray` meets `shape` from behind its surface at exactly `t`: the hit keeps the shape's own
+/// geometric normal `normal` (not turned toward the ray) and says it is back-facing. Returns the
+/// hit for further checks: empty, after a failure, when there is none.
+inline std::optional<Hit> expect_hit_from_behind(const Shape& shape, const Ray& ray, double t,
+                                                 const Normal3& normal) {
+    const std::optional<Hit> hit = shape.intersect(ray);
+    EXPECT_TRUE(hit) << shape.kind();
+    if (!hit) return hit;
+    EXPECT_EQ(hit->t, t) << shape.kind();
+    EXPECT_EQ(hit->geometric_normal, normal) << shape.kind();
+    EXPECT_FALSE(hit->front_face) << shape.kind();
+    return hit;
 }
 
 /// `ray` starts on the surface of the flat (or otherwise once-crossed) `shape` and leaves it:

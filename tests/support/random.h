@@ -78,4 +78,12 @@ inline Aabb enlarged(const Aabb& box, double factor) {
     return Aabb(box.lower - margin, box.upper + margin);
 }
 
+/// The `i`-th of a run of random rays toward `box`: from a box around it (ray_between
+/// enlarged(box, 1.0) and box), and from inside it every fourth ray.
+inline Ray ray_toward(Random& random, const Aabb& box, int i) {
+    Ray ray = random.ray_between(enlarged(box, 1.0), box);
+    if (i % 4 == 0) ray.origin = random.in_box(box);
+    return ray;
+}
+
 }  // namespace csgrt::test

@@ -8,6 +8,7 @@
 #include <functional>
 #include <string>
 
+#include "csgrt/core/math.h"
 #include "csgrt/core/shape.h"
 #include "support/random.h"
 
@@ -25,6 +26,36 @@ struct SurfaceDescription {
     Aabb region;
 };
 
+/// The plane through `anchor` with unit normal `normal` as the zero set of (p - a) . n, of size
+/// `scale`, rays aimed at `region`: any flat shape's surface.
+inline SurfaceDescription plane_surface(const Point3& anchor, const Normal3& normal, double scale,
+                                        const Aabb& region) {
+    return {[anchor, normal](const Point3& p) { return (p - anchor).dot(normal); },
+            [normal](const Point3&) { return Vector3(normal); }, scale, region};
+}
+
+/// The sphere of `center` and `radius` as the zero set of |p - c|^2 - r^2, rays aimed at `region`.
+inline SurfaceDescription sphere_surface(const Point3& center, double radius, const Aabb& region) {
+    return {
+        [center, radius](const Point3& p) { return (p - center).squaredNorm() - square(radius); },
+        [center](const Point3& p) { return Vector3(2.0 * (p - center)); }, radius, region};
+}
+
+/// The torus of `major` radius R and `minor` radius r about the y axis as the zero set of its
+/// quartic (|p|^2 + R^2 - r^2)^2 - 4 R^2 (x^2 + z^2), evaluated in double; rays aimed at `region`.
+inline SurfaceDescription torus_surface(double major, double minor, const Aabb& region) {
+    return {[major, minor](const Point3& p) {
+                return square(p.squaredNorm() + major * major - minor * minor) -
+                       4 * major * major * (p.x() * p.x() + p.z() * p.z());
+            },
+            [major, minor](const Point3& p) {
+                const double k = 4 * (p.squaredNorm() + major * major - minor * minor);
+                return Vector3(k * p.x() - 8 * major * major * p.x(), k * p.y(),
+                               k * p.z() - 8 * major * major * p.z());
+            },
+            minor, region};
+}
+
 /// The tolerances of a property check, in units of the double unit roundoff u = 2^-53 times the
 /// magnitudes involved, so they scale with the coordinates instead of being absolute.
 struct PropertyTolerance {
@@ -35,6 +66,18 @@ struct PropertyTolerance {
     /// the surface by e changes the normal by about e / scale.
     double normal_angle = 1e-9;
 };
+
+/// The tolerance of torus_surface. Near the surface the quartic's own rounding is about
+/// 12 u (2 R rho)^2 (two terms of that size cancel) and its gradient has length 8 R rho r, so it
+/// reports a point on the surface as up to 12 u 4 R^2 rho^2 / (8 R rho r) = 6 u R rho / r
+/// <= 6 u R (R + r) / r away. The check allows distance_ulps u (|o| + |t d| + scale) with
+/// |o| + |t d| >= R - r, so distance_ulps = 6 R (R + r) / (r (R - r)) + 16 (the projected hit
+/// point's own few ulps) covers it.
+inline PropertyTolerance torus_tolerance(double major, double minor) {
+    PropertyTolerance tolerance;
+    tolerance.distance_ulps = 6 * major * (major + minor) / (minor * (major - minor)) + 16;
+    return tolerance;
+}
 
 /// Summary of one property run, so a test can assert how many rays actually hit.
 struct PropertyCounts {

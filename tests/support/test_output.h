@@ -1,9 +1,12 @@
 #pragma once
 
-// Where tests write files: a folder of their own under the build tree's test_output.
+// Where tests write files (a folder of their own under the build tree's test_output), and
+// reading a file back whole.
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -26,6 +29,12 @@ inline std::vector<std::string> names_in(const std::filesystem::path& directory)
     }
     std::sort(names.begin(), names.end());
     return names;
+}
+
+/// The bytes of the file at `path`, read in binary mode: empty when it cannot be opened.
+inline std::string file_contents(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace csgrt::test
