@@ -95,6 +95,8 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     use_avx2_ = config.width == 8 && config.avx2 && __builtin_cpu_supports("avx2") &&
                 __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
                 __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("popcnt");
+#endif
+#if CSGRT_BVH_AVX512
     use_avx512_ = use_avx2_ && __builtin_cpu_supports("avx512f") &&
                   __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
                   __builtin_cpu_supports("avx512dq");

@@ -118,6 +118,7 @@ struct BvhTraversal {
         TraversalCounters& counters) {
         return run<kKind, kCount, true>(bvh, ray, answer, scratch, counters);
     }
+#if CSGRT_BVH_AVX512
     /// run_avx2's code compiled with AVX-512 allowed (Bvh::uses_avx512).
     template <QueryKind kKind, bool kCount>
     [[gnu::target(CSGRT_BVH_AVX512_TARGET), gnu::flatten]] static bool run_avx512(
@@ -125,6 +126,7 @@ struct BvhTraversal {
         TraversalCounters& counters) {
         return run<kKind, kCount, true>(bvh, ray, answer, scratch, counters);
     }
+#endif
 #endif
 
 #if CSGRT_BVH_AVX2
