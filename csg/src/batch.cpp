@@ -65,6 +65,15 @@ void for_blocks(std::size_t count, const BatchConfig& config, const Body& body) 
     });
 }
 
+/// Runs body(i, ray i, scratch) for every ray, in blocks as for_blocks runs them: the walk
+/// of every batch query that answers ray by ray (after check_rays).
+template <class Real, class Body>
+void for_each_ray(const RayArrays<Real>& rays, const BatchConfig& config, const Body& body) {
+    for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
+        for (std::size_t i = begin; i < end; ++i) body(i, rays.ray(i), s);
+    });
+}
+
 template <class Real>
 void write3(std::span<Real> out, std::size_t i, const Vector3& v) {
     if (out.empty()) return;
@@ -133,6 +142,19 @@ void check_structure(const TriangleStructure<Real>& mesh) {
     if (!mesh.object_of_triangle.empty() && mesh.first_triangle.empty()) {
         throw InvalidParameter("first_triangle: needed with object_of_triangle");
     }
+}
+
+/// The preconditions of every ray query, checked before any ray is traced: a committed scene
+/// (or a complete triangle structure) and ray arrays of one size.
+template <class Real>
+void check_inputs(const Scene& scene, const RayArrays<Real>& rays) {
+    check_committed(scene);
+    check_rays(rays);
+}
+template <class Real, class SetReal>
+void check_inputs(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays) {
+    check_structure(mesh);
+    check_rays(rays);
 }
 
 /// A scene's crossings along `ray`: its successive nearest hits, each searched strictly beyond
@@ -255,34 +277,30 @@ Normal3 triangle_normal(const TriangleSet<Real>& set, std::size_t i) {
 template <class Real>
 void intersect(const Scene& scene, const RayArrays<Real>& rays,
                const NearestHitOutputs<Real>& outputs, const BatchConfig& config) {
-    check_committed(scene);
-    check_rays(rays);
+    check_inputs(scene, rays);
     check_outputs(outputs, rays.size());
-    for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        for (std::size_t i = begin; i < end; ++i) {
-            const auto hit = scene.intersect(rays.ray(i), s);
-            if (!hit) {
-                write_miss(outputs, i);
-                continue;
-            }
-            write1(outputs.t, i, static_cast<Real>(hit->t));
-            write1(outputs.object_id, i, hit->object_id);
-            write1(outputs.primitive_id, i, hit->primitive_id);
-            write2(outputs.uv, i, hit->uv.x(), hit->uv.y());
-            write3(outputs.geometric_normal, i, hit->geometric_normal);
-            write3(outputs.shading_normal, i, hit->shading_normal);
-            write1(outputs.material, i,
-                   hit->material != kNoIndex ? hit->material
-                                             : scene.objects()[hit->object_id].material);
+    for_each_ray(rays, config, [&](std::size_t i, const Ray& ray, QueryScratch& s) {
+        const auto hit = scene.intersect(ray, s);
+        if (!hit) {
+            write_miss(outputs, i);
+            return;
         }
+        write1(outputs.t, i, static_cast<Real>(hit->t));
+        write1(outputs.object_id, i, hit->object_id);
+        write1(outputs.primitive_id, i, hit->primitive_id);
+        write2(outputs.uv, i, hit->uv.x(), hit->uv.y());
+        write3(outputs.geometric_normal, i, hit->geometric_normal);
+        write3(outputs.shading_normal, i, hit->shading_normal);
+        write1(outputs.material, i,
+               hit->material != kNoIndex ? hit->material
+                                         : scene.objects()[hit->object_id].material);
     });
 }
 
 template <class Real, class SetReal>
 void intersect(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
                const NearestHitOutputs<Real>& outputs, const BatchConfig& config) {
-    check_structure(mesh);
-    check_rays(rays);
+    check_inputs(mesh, rays);
     check_outputs(outputs, rays.size());
     if (!outputs.material.empty()) {
         throw InvalidParameter("material: a triangle structure has no materials");
@@ -334,19 +352,17 @@ void intersect(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& ra
 template <class Real>
 void occluded(const Scene& scene, const RayArrays<Real>& rays, std::span<std::uint8_t> occluded,
               const BatchConfig& config) {
-    check_committed(scene);
-    check_rays(rays);
+    check_inputs(scene, rays);
     check_size(occluded.size(), rays.size(), "occluded");
-    for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        for (std::size_t i = begin; i < end; ++i) occluded[i] = scene.occluded(rays.ray(i), s);
+    for_each_ray(rays, config, [&](std::size_t i, const Ray& ray, QueryScratch& s) {
+        occluded[i] = scene.occluded(ray, s);
     });
 }
 
 template <class Real, class SetReal>
 void occluded(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
               std::span<std::uint8_t> occluded, const BatchConfig& config) {
-    check_structure(mesh);
-    check_rays(rays);
+    check_inputs(mesh, rays);
     check_size(occluded.size(), rays.size(), "occluded");
     const auto* bvh = dynamic_cast<const Bvh<TriangleSet<SetReal>>*>(mesh.structure);
     for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
@@ -362,28 +378,21 @@ void occluded(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& ray
 template <class Real>
 void count_crossings(const Scene& scene, const RayArrays<Real>& rays,
                      std::span<std::uint32_t> counts, const BatchConfig& config) {
-    check_committed(scene);
-    check_rays(rays);
+    check_inputs(scene, rays);
     check_size(counts.size(), rays.size(), "counts");
-    for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        for (std::size_t i = begin; i < end; ++i) {
-            counts[i] = scene_crossings(scene, rays.ray(i), s, [](const Hit&) {});
-        }
+    for_each_ray(rays, config, [&](std::size_t i, const Ray& ray, QueryScratch& s) {
+        counts[i] = scene_crossings(scene, ray, s, [](const Hit&) {});
     });
 }
 
 template <class Real, class SetReal>
 void count_crossings(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
                      std::span<std::uint32_t> counts, const BatchConfig& config) {
-    check_structure(mesh);
-    check_rays(rays);
+    check_inputs(mesh, rays);
     check_size(counts.size(), rays.size(), "counts");
-    for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        for (std::size_t i = begin; i < end; ++i) {
-            BorrowedHits hits(s);
-            counts[i] =
-                static_cast<std::uint32_t>(triangle_crossings(mesh, rays.ray(i), hits.list(), s));
-        }
+    for_each_ray(rays, config, [&](std::size_t i, const Ray& ray, QueryScratch& s) {
+        BorrowedHits hits(s);
+        counts[i] = static_cast<std::uint32_t>(triangle_crossings(mesh, ray, hits.list(), s));
     });
 }
 
@@ -400,56 +409,49 @@ void crossing_offsets(std::span<const std::uint32_t> counts, std::span<std::uint
 template <class Real>
 void list_crossings(const Scene& scene, const RayArrays<Real>& rays,
                     const CrossingOutputs<Real>& outputs, const BatchConfig& config) {
-    check_committed(scene);
-    check_rays(rays);
+    check_inputs(scene, rays);
     check_crossing_outputs(outputs, rays.size());
-    for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        for (std::size_t i = begin; i < end; ++i) {
-            const std::uint64_t first = outputs.offsets[i];
-            const std::uint64_t slot = outputs.offsets[i + 1] - first;
-            std::uint64_t k = 0;
-            const std::uint32_t found = scene_crossings(scene, rays.ray(i), s, [&](const Hit& hit) {
-                if (k < slot) {
-                    const std::size_t at = first + k;
-                    write1(outputs.t, at, static_cast<Real>(hit.t));
-                    write1(outputs.object_id, at, hit.object_id);
-                    write1(outputs.primitive_id, at, hit.primitive_id);
-                    write2(outputs.uv, at, hit.uv.x(), hit.uv.y());
-                    write1(outputs.entering, at, std::uint8_t(hit.front_face ? 1 : 0));
-                }
-                ++k;
-            });
-            check_slot(found, slot, i);
-        }
+    for_each_ray(rays, config, [&](std::size_t i, const Ray& ray, QueryScratch& s) {
+        const std::uint64_t first = outputs.offsets[i];
+        const std::uint64_t slot = outputs.offsets[i + 1] - first;
+        std::uint64_t k = 0;
+        const std::uint32_t found = scene_crossings(scene, ray, s, [&](const Hit& hit) {
+            if (k < slot) {
+                const std::size_t at = first + k;
+                write1(outputs.t, at, static_cast<Real>(hit.t));
+                write1(outputs.object_id, at, hit.object_id);
+                write1(outputs.primitive_id, at, hit.primitive_id);
+                write2(outputs.uv, at, hit.uv.x(), hit.uv.y());
+                write1(outputs.entering, at, std::uint8_t(hit.front_face ? 1 : 0));
+            }
+            ++k;
+        });
+        check_slot(found, slot, i);
     });
 }
 
 template <class Real, class SetReal>
 void list_crossings(const TriangleStructure<SetReal>& mesh, const RayArrays<Real>& rays,
                     const CrossingOutputs<Real>& outputs, const BatchConfig& config) {
-    check_structure(mesh);
-    check_rays(rays);
+    check_inputs(mesh, rays);
     check_crossing_outputs(outputs, rays.size());
-    for_blocks(rays.size(), config, [&](std::size_t begin, std::size_t end, QueryScratch& s) {
-        for (std::size_t i = begin; i < end; ++i) {
-            BorrowedHits borrowed(s);
-            std::vector<HitRecord>& hits = borrowed.list();
-            const Ray ray = rays.ray(i);
-            const std::size_t found = triangle_crossings(mesh, ray, hits, s);
-            const std::uint64_t first = outputs.offsets[i];
-            check_slot(found, outputs.offsets[i + 1] - first, i);
-            for (std::size_t k = 0; k < found; ++k) {
-                const std::size_t at = first + k;
-                std::uint32_t object, primitive;
-                triangle_ids(mesh, hits[k].primitive, object, primitive);
-                write1(outputs.t, at, static_cast<Real>(hits[k].t));
-                write1(outputs.object_id, at, object);
-                write1(outputs.primitive_id, at, primitive);
-                write2(outputs.uv, at, double(hits[k].u), double(hits[k].v));
-                if (!outputs.entering.empty()) {
-                    const Normal3 n = triangle_normal(*mesh.triangles, hits[k].primitive);
-                    outputs.entering[at] = n.dot(ray.direction) < 0.0 ? 1 : 0;
-                }
+    for_each_ray(rays, config, [&](std::size_t i, const Ray& ray, QueryScratch& s) {
+        BorrowedHits borrowed(s);
+        std::vector<HitRecord>& hits = borrowed.list();
+        const std::size_t found = triangle_crossings(mesh, ray, hits, s);
+        const std::uint64_t first = outputs.offsets[i];
+        check_slot(found, outputs.offsets[i + 1] - first, i);
+        for (std::size_t k = 0; k < found; ++k) {
+            const std::size_t at = first + k;
+            std::uint32_t object, primitive;
+            triangle_ids(mesh, hits[k].primitive, object, primitive);
+            write1(outputs.t, at, static_cast<Real>(hits[k].t));
+            write1(outputs.object_id, at, object);
+            write1(outputs.primitive_id, at, primitive);
+            write2(outputs.uv, at, double(hits[k].u), double(hits[k].v));
+            if (!outputs.entering.empty()) {
+                const Normal3 n = triangle_normal(*mesh.triangles, hits[k].primitive);
+                outputs.entering[at] = n.dot(ray.direction) < 0.0 ? 1 : 0;
             }
         }
     });
