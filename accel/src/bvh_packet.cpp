@@ -181,12 +181,7 @@ struct BvhTraversal<Set>::Packets {
                                          child_enter[slot]};
                     prefetch(bvh, nodes, node.first[slot], node.count[slot]);
                 }
-                for (PacketEntry* i = pushed + 1; i != top; ++i) {
-                    const PacketEntry entry = *i;
-                    PacketEntry* j = i;
-                    for (; j != pushed && (j - 1)->t_enter < entry.t_enter; --j) *j = *(j - 1);
-                    *j = entry;
-                }
+                sort_farthest_first(pushed, top);
                 --top;
                 first = top->first;
                 count = top->count;

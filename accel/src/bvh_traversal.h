@@ -146,6 +146,19 @@ struct BvhTraversal {
     }
 #endif
 
+    /// Orders the entries a node just pushed, [pushed, top), farthest entry first, so that the
+    /// nearest is popped next (an insertion sort: at most a node's width of them; entries
+    /// entered as far keep the order they were pushed in). Any entry type with a t_enter.
+    template <class Entry>
+    static void sort_farthest_first(Entry* pushed, Entry* top) {
+        for (Entry* i = pushed + 1; i != top; ++i) {
+            const Entry entry = *i;
+            Entry* j = i;
+            for (; j != pushed && (j - 1)->t_enter < entry.t_enter; --j) *j = *(j - 1);
+            *j = entry;
+        }
+    }
+
     /// Starts loading what a leaf or node the traversal will come back to needs: a node's
     /// cache lines, a leaf's first block, a one-primitive leaf's primitive, or a leaf's
     /// indices.
@@ -323,12 +336,7 @@ struct BvhTraversal {
                     *top++ = WideEntry{node.first[slot], node.count[slot], t_enter[slot]};
                     prefetch(bvh, nodes, node.first[slot], node.count[slot]);
                 } while (mask != 0);
-                for (WideEntry* i = pushed + 1; i != top; ++i) {
-                    const WideEntry entry = *i;
-                    WideEntry* j = i;
-                    for (; j != pushed && (j - 1)->t_enter < entry.t_enter; --j) *j = *(j - 1);
-                    *j = entry;
-                }
+                sort_farthest_first(pushed, top);
                 --top;
                 first = top->first;
                 count = top->count;
