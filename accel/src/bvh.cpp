@@ -90,16 +90,11 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
     config_ = config;
     constexpr bool kBlockSet = detail::kBlockLeaves<Set>;
     const bool blocks = kBlockSet && config.triangle_blocks;
-    use_avx2_ = use_avx512_ = false;
+    use_avx2_ = false;
 #if CSGRT_BVH_AVX2
     use_avx2_ = config.width == 8 && config.avx2 && __builtin_cpu_supports("avx2") &&
                 __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
                 __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("popcnt");
-#endif
-#if CSGRT_BVH_AVX512
-    use_avx512_ = use_avx2_ && __builtin_cpu_supports("avx512f") &&
-                  __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
-                  __builtin_cpu_supports("avx512dq");
 #endif
 
     // Left uninitialised here (AlignedAllocator default-initialises) and written in parallel
@@ -175,9 +170,7 @@ void Bvh<Set>::build(const Set& set, const BvhConfig& config) {
         tree.leaves ? double(set.size()) / double(tree.leaves) : 0.0,
         leaf_triangles_.lanes.size() / (10 * kBvhLeafLaneGroup), tree.sah_cost, config.bins,
         set.size() ? double(stats_.bytes) / double(set.size()) : 0.0,
-        use_avx512_ ? ", AVX2 with AVX-512"
-        : use_avx2_ ? ", AVX2"
-                    : "");
+        use_avx2_ ? ", AVX2" : "");
     stats_.details = details;
     stats_.build_milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

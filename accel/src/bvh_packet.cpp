@@ -217,15 +217,6 @@ struct BvhTraversal<Set>::Packets {
         traverse_packet<kAny, Avx2NodeTest>(bvh, bvh.nodes_8_, rays, best, found, scratch);
     }
 #endif
-#if CSGRT_BVH_AVX512
-    /// traverse_packet_avx2 compiled with AVX-512 allowed (Bvh::uses_avx512).
-    template <bool kAny>
-    [[gnu::target(CSGRT_BVH_AVX512_TARGET), gnu::flatten]] static void traverse_packet_avx512(
-        const Tree& bvh, std::span<const Ray> rays, HitRecord* best, bool* found,
-        QueryScratch& scratch) {
-        traverse_packet<kAny, Avx2NodeTest>(bvh, bvh.nodes_8_, rays, best, found, scratch);
-    }
-#endif
 
 #if CSGRT_BVH_AVX2
     /// The nearest hits (or occlusion) of a packet whose rays PacketIntervalTest accepts: the
@@ -345,10 +336,6 @@ struct BvhTraversal<Set>::Packets {
     static void packet(const Tree& bvh, std::span<const Ray> rays, HitRecord* best, bool* found,
                        QueryScratch& scratch) {
         if (bvh.config_.width == 8) {
-#if CSGRT_BVH_AVX512
-            if (bvh.use_avx512_)
-                return traverse_packet_avx512<kAny>(bvh, rays, best, found, scratch);
-#endif
 #if CSGRT_BVH_AVX2
             if (bvh.use_avx2_) return traverse_packet_avx2<kAny>(bvh, rays, best, found, scratch);
 #endif

@@ -26,22 +26,12 @@
 /// AVX2 CPU also has (BMI1/2 and POPCNT: the walk's child masks take tzcnt and blsr rather
 /// than bsf with a zero test), which build() checks the CPU for with the others.
 #define CSGRT_BVH_AVX2_TARGET "avx2,fma,bmi,bmi2,popcnt"
-/// The AVX2 queries compiled once more with AVX-512 (F, VL, BW, DQ) allowed: the same intrinsics,
-/// so the same operations and bits, but 32 vector registers and mask registers to keep the ray's
-/// and the node's values in.
-#define CSGRT_BVH_AVX512_TARGET "avx2,fma,bmi,bmi2,popcnt,avx512f,avx512vl,avx512bw,avx512dq"
-/// Whether that second compilation is made. The sanitized builds (CSGRT_SANITIZE, CSGRT_TSAN)
-/// set it to 0 (CMakeLists.txt): it is the AVX2 code's source once more, so what a sanitizer
-/// checks there it checks in the AVX2 code, and it doubled the compile time of the two
-/// sources that hold the queries (bvh_traversal.cpp: 154 s against 81 s under ASan).
-#ifndef CSGRT_BVH_AVX512
-#define CSGRT_BVH_AVX512 1
-#endif
+/// There is no second compilation of the AVX2 code with AVX-512 allowed: it was made until
+/// 2026-12-07 and measured no faster (docs/benchmarks.md, "AVX-512 compilation"), while it doubled the
+/// compile time of the two sources that hold the queries.
 #include <immintrin.h>
 #else
 #define CSGRT_BVH_AVX2 0
-#undef CSGRT_BVH_AVX512
-#define CSGRT_BVH_AVX512 0
 #endif
 
 namespace csgrt::detail {

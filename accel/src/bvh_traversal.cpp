@@ -15,11 +15,6 @@ template <QueryKind kKind, bool kCounted>
 bool Bvh<Set>::query(const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
                      TraversalCounters& counters) const {
     using Traversal = detail::BvhTraversal<Set>;
-#if CSGRT_BVH_AVX512
-    if (use_avx512_)
-        return Traversal::template run_avx512<kKind, kCounted>(*this, ray, answer, scratch,
-                                                               counters);
-#endif
 #if CSGRT_BVH_AVX2
     if (use_avx2_)
         return Traversal::template run_avx2<kKind, kCounted>(*this, ray, answer, scratch, counters);

@@ -41,7 +41,7 @@ struct BvhTraversal {
     /// returns whether the ray is valid (is_valid; an invalid ray visits nothing). `leaf` is
     /// called as leaf(first, count, t_max) with the leaf's reference (see Bvh::binary_nodes)
     /// and the float upper bound of the interval, which it may lower; it returns true to stop.
-    /// kAvx2: the 8-wide tree with the AVX2 node tests (run_avx2 and run_avx512 only).
+    /// kAvx2: the 8-wide tree with the AVX2 node tests (run_avx2 only).
     template <bool kCount, bool kAvx2, bool kNearestFirst = true, class Leaf>
     static bool traverse(const Tree& bvh, const Ray& ray, TraversalCounters& counters, Leaf& leaf) {
 #if CSGRT_BVH_AVX2
@@ -118,15 +118,6 @@ struct BvhTraversal {
         TraversalCounters& counters) {
         return run<kKind, kCount, true>(bvh, ray, answer, scratch, counters);
     }
-#if CSGRT_BVH_AVX512
-    /// run_avx2's code compiled with AVX-512 allowed (Bvh::uses_avx512).
-    template <QueryKind kKind, bool kCount>
-    [[gnu::target(CSGRT_BVH_AVX512_TARGET), gnu::flatten]] static bool run_avx512(
-        const Tree& bvh, const Ray& ray, QueryAnswer<kKind>& answer, QueryScratch& scratch,
-        TraversalCounters& counters) {
-        return run<kKind, kCount, true>(bvh, ray, answer, scratch, counters);
-    }
-#endif
 #endif
 
 #if CSGRT_BVH_AVX2

@@ -83,9 +83,6 @@ public:
     const BvhLeafTriangles& leaf_triangles() const { return leaf_triangles_; }
     /// Whether queries run the AVX2 node test (BvhConfig::avx2 and a CPU that has AVX2 and FMA).
     bool uses_avx2() const { return use_avx2_; }
-    /// Whether they run it compiled with AVX-512 allowed (uses_avx2() and a CPU with AVX-512 F,
-    /// VL, BW and DQ): the same operations, so the same answers and counters.
-    bool uses_avx512() const { return use_avx512_; }
 
 private:
     friend struct detail::BvhTraversal<Set>;
@@ -102,7 +99,6 @@ private:
     const Set* set_ = nullptr;
     BvhConfig config_;
     bool use_avx2_ = false;
-    bool use_avx512_ = false;
     std::vector<BvhNode, AlignedAllocator<BvhNode>> binary_nodes_;
     WideBvhNodes<4> nodes_4_;
     WideBvhNodes<8> nodes_8_;
