@@ -403,23 +403,15 @@ std::size_t Bvh<Set>::occluded_packets(std::span<const Ray> rays, std::span<bool
     return trace_packets<true>(rays, {}, occluded, scratch);
 }
 
-template std::size_t Bvh<TriangleSet<float>>::intersect_packets(std::span<const Ray>,
-                                                                std::span<HitRecord>,
-                                                                std::span<bool>,
-                                                                QueryScratch&) const;
-template std::size_t Bvh<TriangleSet<float>>::occluded_packets(std::span<const Ray>,
-                                                               std::span<bool>,
-                                                               QueryScratch&) const;
-template std::size_t Bvh<TriangleSet<double>>::intersect_packets(std::span<const Ray>,
-                                                                 std::span<HitRecord>,
-                                                                 std::span<bool>,
-                                                                 QueryScratch&) const;
-template std::size_t Bvh<TriangleSet<double>>::occluded_packets(std::span<const Ray>,
-                                                                std::span<bool>,
-                                                                QueryScratch&) const;
-template std::size_t Bvh<ShapeSet>::intersect_packets(std::span<const Ray>, std::span<HitRecord>,
-                                                      std::span<bool>, QueryScratch&) const;
-template std::size_t Bvh<ShapeSet>::occluded_packets(std::span<const Ray>, std::span<bool>,
-                                                     QueryScratch&) const;
+// The packet queries of each set a Bvh is built over.
+#define CSGRT_INSTANTIATE_PACKETS(Set)                                                         \
+    template std::size_t Bvh<Set>::intersect_packets(std::span<const Ray>, std::span<HitRecord>, \
+                                                     std::span<bool>, QueryScratch&) const;     \
+    template std::size_t Bvh<Set>::occluded_packets(std::span<const Ray>, std::span<bool>,       \
+                                                    QueryScratch&) const;
+CSGRT_INSTANTIATE_PACKETS(TriangleSet<float>)
+CSGRT_INSTANTIATE_PACKETS(TriangleSet<double>)
+CSGRT_INSTANTIATE_PACKETS(ShapeSet)
+#undef CSGRT_INSTANTIATE_PACKETS
 
 }  // namespace csgrt
