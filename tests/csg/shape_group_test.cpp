@@ -13,6 +13,7 @@
 #include "csgrt/core/sphere.h"
 #include "csgrt/csg/compound.h"
 #include "support/random.h"
+#include "support/scene_parts.h"
 
 namespace csgrt {
 namespace {
@@ -58,10 +59,6 @@ public:
     bool contains(const Point3&) const override { return false; }
 };
 
-std::shared_ptr<const Shape> ground(double height) {
-    return std::make_shared<Plane>(Point3(0, height, 0), Normal3(0, 1, 0));
-}
-
 // The exact repeats among mixed_members' spheres (i = 3, 10, 17, 24), which a group drops.
 constexpr std::size_t kMixedRepeats = 4;
 
@@ -70,14 +67,14 @@ constexpr std::size_t kMixedRepeats = 4;
 Shapes mixed_members(std::uint64_t seed) {
     test::Random random(seed);
     Shapes members;
-    members.push_back(ground(-3.0));
+    members.push_back(test::ground_plane(-3.0));
     members.push_back(std::make_shared<Nothing>());
     for (int i = 0; i < 30; ++i) {
         const Point3 centre = random.in_box(Aabb(Point3(-4, -2, -4), Point3(4, 2, 4)));
         members.push_back(std::make_shared<Sphere>(centre, random.uniform(0.2, 1.0)));
         if (i % 7 == 3) members.push_back(members.back());
     }
-    members.push_back(ground(3.5));
+    members.push_back(test::ground_plane(3.5));
     return members;
 }
 
@@ -163,7 +160,7 @@ TEST(ShapeGroup, EveryStructureGivesTheLoopsNearestAnyAndAllHits) {
 }
 
 TEST(ShapeGroup, ATieBetweenABoundedAndAnUnboundedMemberGoesToTheLowerIndex) {
-    const auto plane = ground(0.0);
+    const auto plane = test::ground_plane(0.0);
     const auto boxed = std::make_shared<BoxedPlane>(plane);
     const Ray down{Point3(0.25, 5, -0.5), Vector3(0.1, -1, 0.2)};
     QueryScratch scratch;
@@ -250,8 +247,8 @@ TEST(ShapeGroup, ExactRepeatsAreDroppedAndTheNearestHitIsTheLoops) {
 }
 
 TEST(ShapeGroup, RejectsANullMemberAndAnUnknownStructure) {
-    EXPECT_THROW(ShapeGroup(Shapes{ground(0), nullptr}, "auto", {}), InvalidParameter);
-    EXPECT_THROW(ShapeGroup(Shapes{ground(0)}, "octree", {}), InvalidParameter);
+    EXPECT_THROW(ShapeGroup(Shapes{test::ground_plane(0), nullptr}, "auto", {}), InvalidParameter);
+    EXPECT_THROW(ShapeGroup(Shapes{test::ground_plane(0)}, "octree", {}), InvalidParameter);
 }
 
 }  // namespace
