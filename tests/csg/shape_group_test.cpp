@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "csgrt/accel/factory.h"
@@ -95,6 +96,23 @@ bool nearest_by_loop(const Shapes& members, const Ray& ray, HitRecord& best) {
     return found;
 }
 
+// Checks the group's nearest and any for `ray` (the k-th ray) against the loop's: the same
+// shapes asked the same ray, so identical to the bit. `loop_hit` receives the loop's nearest
+// hit. A hit/miss disagreement is fatal: call under ASSERT_NO_FATAL_FAILURE.
+void expect_group_agrees_with_loop(const ShapeGroup& group, const Shapes& members, const Ray& ray,
+                                   int k, QueryScratch& scratch,
+                                   std::optional<HitRecord>& loop_hit) {
+    HitRecord expected, actual;
+    const bool found = nearest_by_loop(members, ray, expected);
+    loop_hit.reset();
+    ASSERT_EQ(group.nearest(ray, actual, scratch), found) << k;
+    EXPECT_EQ(group.any(ray, scratch), found) << k;
+    if (!found) return;
+    loop_hit = expected;
+    EXPECT_EQ(actual.t, expected.t) << k;
+    EXPECT_EQ(actual.object, expected.object) << k;
+}
+
 TEST(ShapeGroup, SplitsMembersIntoBoundedAndUnboundedAndDropsEmptyOnes) {
     const Shapes members = mixed_members(1);
     const ShapeGroup group(members, "auto", {});
@@ -123,20 +141,17 @@ TEST(ShapeGroup, EveryStructureGivesTheLoopsNearestAnyAndAllHits) {
         for (int k = 0; k < 400; ++k) {
             const Point3 origin = random.in_box(Aabb(Point3(-6, -5, -6), Point3(6, 5, 6)));
             const Ray ray{origin, random.unit_vector()};
-            HitRecord expected, actual;
-            const bool found = nearest_by_loop(members, ray, expected);
-            ASSERT_EQ(group.nearest(ray, actual, scratch), found) << k;
-            EXPECT_EQ(group.any(ray, scratch), found) << k;
+            std::optional<HitRecord> expected;
+            ASSERT_NO_FATAL_FAILURE(
+                expect_group_agrees_with_loop(group, members, ray, k, scratch, expected));
             TraversalCounters counters;
             HitRecord counted;
-            ASSERT_EQ(group.nearest_counted(ray, counted, scratch, counters), found) << k;
-            if (found) {
+            ASSERT_EQ(group.nearest_counted(ray, counted, scratch, counters), expected.has_value())
+                << k;
+            if (expected) {
                 ++hits;
-                // The same shapes asked the same rays: identical, to the bit.
-                EXPECT_EQ(actual.t, expected.t) << k;
-                EXPECT_EQ(actual.object, expected.object) << k;
-                EXPECT_EQ(counted.t, expected.t) << k;
-                EXPECT_EQ(counted.object, expected.object) << k;
+                EXPECT_EQ(counted.t, expected->t) << k;
+                EXPECT_EQ(counted.object, expected->object) << k;
                 EXPECT_GE(counters.primitives_tested, group.unbounded().size()) << k;
             }
             std::vector<HitRecord> all;
@@ -223,14 +238,9 @@ TEST(ShapeGroup, ExactRepeatsAreDroppedAndTheNearestHitIsTheLoops) {
         QueryScratch scratch;
         for (int k = 0; k < 200; ++k) {
             const Point3 origin = random.in_box(Aabb(Point3(-4, -4, -4), Point3(4, 4, 4)));
-            const Ray ray{origin, random.unit_vector()};
-            HitRecord expected, actual;
-            const bool found = nearest_by_loop(members, ray, expected);
-            ASSERT_EQ(group.nearest(ray, actual, scratch), found) << k;
-            EXPECT_EQ(group.any(ray, scratch), found) << k;
-            if (!found) continue;
-            EXPECT_EQ(actual.t, expected.t) << k;
-            EXPECT_EQ(actual.object, expected.object) << k;
+            std::optional<HitRecord> expected;
+            ASSERT_NO_FATAL_FAILURE(expect_group_agrees_with_loop(
+                group, members, Ray{origin, random.unit_vector()}, k, scratch, expected));
         }
     }
     // 4096 coincident copies, each its own Instance, cost one primitive test a ray.
