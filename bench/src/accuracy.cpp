@@ -160,8 +160,8 @@ TriangleRays triangle_rays(const TriangleMeshData& mesh, const Settings& setting
     for (std::size_t attempt = 0;
          rays.edges.size() < settings.accuracy_rays && attempt < 1000 * settings.accuracy_rays;
          ++attempt) {
-        const auto& triangle = mesh.triangles[random.next() % count];
-        const int corner = static_cast<int>(random.next() % 3);
+        const auto& triangle = mesh.triangles[random.next_bits() % count];
+        const int corner = static_cast<int>(random.next_bits() % 3);
         const std::uint32_t a = triangle[corner], b = triangle[(corner + 1) % 3];
         // Every other ray through a vertex, the rest through a point of an edge.
         const bool vertex = rays.edges.size() % 2 == 0;

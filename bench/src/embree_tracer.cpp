@@ -83,32 +83,24 @@ public:
 
     std::size_t nearest(std::span<const Ray> rays, QueryScratch&) const override {
         if (packets_) return nearest_packets(rays);
-        std::size_t hits = 0;
-        for (const Ray& ray : rays) {
-            RTCIntersectContext context;
-            rtcInitIntersectContext(&context);
+        return one_by_one(rays, [&](RTCIntersectContext& context, const Ray& ray) {
             RTCRayHit query;
             fill(ray, query.ray);
             query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
             query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
             rtcIntersect1(scene_, &context, &query);
-            hits += query.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
-        }
-        return hits;
+            return query.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        });
     }
     std::size_t occluded(std::span<const Ray> rays, QueryScratch&) const override {
         if (packets_) return occluded_packets(rays);
-        std::size_t hits = 0;
-        for (const Ray& ray : rays) {
-            RTCIntersectContext context;
-            rtcInitIntersectContext(&context);
+        return one_by_one(rays, [&](RTCIntersectContext& context, const Ray& ray) {
             RTCRay query;
             fill(ray, query);
             rtcOccluded1(scene_, &context, &query);
             // Embree marks an occluded ray by setting tfar to -inf.
-            hits += query.tfar == -INFINITY ? 1 : 0;
-        }
-        return hits;
+            return query.tfar == -INFINITY;
+        });
     }
 
 private:
@@ -142,6 +134,19 @@ private:
             packet.id[l] = single.id;
             packet.flags[l] = single.flags;
         }
+    }
+
+    /// Traces `rays` one at a time, each with its own default context, by `trace(context, ray)`,
+    /// which returns whether the ray hit; returns how many did.
+    template <class Trace>
+    static std::size_t one_by_one(std::span<const Ray> rays, const Trace& trace) {
+        std::size_t hits = 0;
+        for (const Ray& ray : rays) {
+            RTCIntersectContext context;
+            rtcInitIntersectContext(&context);
+            hits += trace(context, ray) ? 1 : 0;
+        }
+        return hits;
     }
 
     /// Traces `rays` in packets of kPacket consecutive rays, each with a coherent context and

@@ -48,23 +48,6 @@ struct Result {
     double counter(const std::string& key) const;
 };
 
-/// Forwards everything to the reporter chosen by --benchmark_format (so the standard flags
-/// keep working) and keeps a Result for each run.
-class CollectingReporter final : public benchmark::BenchmarkReporter {
-public:
-    explicit CollectingReporter(benchmark::BenchmarkReporter* display);
-
-    bool ReportContext(const Context& context) override;
-    void ReportRuns(const std::vector<Run>& runs) override;
-    void Finalize() override;
-
-    const std::vector<Result>& results() const { return results_; }
-
-private:
-    std::unique_ptr<benchmark::BenchmarkReporter> display_;
-    std::vector<Result> results_;
-};
-
 /// `runs` with each ray rate (the benchmarks' "rays" counter, already per second) reported as
 /// Google Benchmark's own throughput field, items_per_second, which tools that read its
 /// console and JSON output know. The Results keep the name "rays".
@@ -72,8 +55,8 @@ std::vector<benchmark::BenchmarkReporter::Run> with_items_per_second(
     const std::vector<benchmark::BenchmarkReporter::Run>& runs);
 
 /// Forwards everything to `inner` (for --benchmark_out: the file reporter) with the ray rates
-/// as items_per_second.
-class ThroughputReporter final : public benchmark::BenchmarkReporter {
+/// as items_per_second, in the streams the library gives this reporter.
+class ThroughputReporter : public benchmark::BenchmarkReporter {
 public:
     explicit ThroughputReporter(benchmark::BenchmarkReporter* inner);
 
@@ -83,6 +66,20 @@ public:
 
 private:
     std::unique_ptr<benchmark::BenchmarkReporter> inner_;
+};
+
+/// Forwards everything to the reporter chosen by --benchmark_format (so the standard flags
+/// keep working), as a ThroughputReporter does, and keeps a Result for each run.
+class CollectingReporter final : public ThroughputReporter {
+public:
+    explicit CollectingReporter(benchmark::BenchmarkReporter* display);
+
+    void ReportRuns(const std::vector<Run>& runs) override;
+
+    const std::vector<Result>& results() const { return results_; }
+
+private:
+    std::vector<Result> results_;
 };
 
 /// A one-line-per-benchmark display for --quick: the name and its Mrays/s (Google

@@ -32,12 +32,6 @@ double Result::counter(const std::string& key) const {
     return found == counters.end() ? std::numeric_limits<double>::quiet_NaN() : found->second;
 }
 
-CollectingReporter::CollectingReporter(benchmark::BenchmarkReporter* display) : display_(display) {}
-
-bool CollectingReporter::ReportContext(const Context& context) {
-    return display_->ReportContext(context);
-}
-
 std::vector<benchmark::BenchmarkReporter::Run> with_items_per_second(
     const std::vector<benchmark::BenchmarkReporter::Run>& runs) {
     std::vector<benchmark::BenchmarkReporter::Run> converted = runs;
@@ -54,7 +48,8 @@ std::vector<benchmark::BenchmarkReporter::Run> with_items_per_second(
 ThroughputReporter::ThroughputReporter(benchmark::BenchmarkReporter* inner) : inner_(inner) {}
 
 bool ThroughputReporter::ReportContext(const Context& context) {
-    // The library points this reporter at the --benchmark_out file; the inner one writes there.
+    // The library points a file reporter at the --benchmark_out file and leaves a display
+    // reporter on the standard streams: the inner one writes where this one would.
     inner_->SetOutputStream(&GetOutputStream());
     inner_->SetErrorStream(&GetErrorStream());
     return inner_->ReportContext(context);
@@ -68,8 +63,11 @@ void ThroughputReporter::Finalize() {
     inner_->Finalize();
 }
 
+CollectingReporter::CollectingReporter(benchmark::BenchmarkReporter* display)
+    : ThroughputReporter(display) {}
+
 void CollectingReporter::ReportRuns(const std::vector<Run>& runs) {
-    display_->ReportRuns(with_items_per_second(runs));
+    ThroughputReporter::ReportRuns(runs);
     for (const Run& run : runs) {
         // Repetitions: keep the median aggregate if there is one, else the last run.
         const bool aggregate = run.run_type == Run::RT_Aggregate;
@@ -99,10 +97,6 @@ void CollectingReporter::ReportRuns(const std::vector<Run>& runs) {
             results_.push_back(result);
         }
     }
-}
-
-void CollectingReporter::Finalize() {
-    display_->Finalize();
 }
 
 namespace {

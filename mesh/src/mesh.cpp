@@ -170,13 +170,7 @@ std::shared_ptr<Mesh> Mesh::load(const std::filesystem::path& path, const MeshCo
     if (config.weld_vertices) {
         // Validated again on the welded mesh: its topology (closed or not) is what changes.
         const std::size_t welded = weld_vertices(mesh);
-        MeshReport topology = validate_mesh(mesh);
-        topology.format = report.format;
-        topology.binary = report.binary;
-        topology.faces = report.faces;
-        topology.dropped_faces = report.dropped_faces;
-        topology.triangulated_faces = report.triangulated_faces;
-        topology.non_simple_faces = report.non_simple_faces;
+        MeshReport topology = validate_mesh(mesh, report);
         topology.welded_vertices = welded;
         report = std::move(topology);
     }

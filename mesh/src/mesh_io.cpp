@@ -349,14 +349,7 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
              std::to_string(mesh.vertices.size()) + " vertices (at most 2^32 - 2)");
     }
     try {
-        MeshReport validation = validate_mesh(mesh);
-        validation.format = report.format;
-        validation.binary = report.binary;
-        validation.faces = report.faces;
-        validation.dropped_faces = report.dropped_faces;
-        validation.triangulated_faces = report.triangulated_faces;
-        validation.non_simple_faces = report.non_simple_faces;
-        report = std::move(validation);
+        report = validate_mesh(mesh, report);
     } catch (const InvalidParameter&) {
         // Vertices and indices were checked above; what validation can still reject is a mesh
         // whose every triangle has zero area.

@@ -284,4 +284,15 @@ MeshReport validate_mesh(TriangleMeshData& mesh) {
     return report;
 }
 
+MeshReport validate_mesh(TriangleMeshData& mesh, const MeshReport& as_read) {
+    MeshReport report = validate_mesh(mesh);
+    report.format = as_read.format;
+    report.binary = as_read.binary;
+    report.faces = as_read.faces;
+    report.dropped_faces = as_read.dropped_faces;
+    report.triangulated_faces = as_read.triangulated_faces;
+    report.non_simple_faces = as_read.non_simple_faces;
+    return report;
+}
+
 }  // namespace csgrt

@@ -115,7 +115,7 @@ std::optional<LightSample> sample_light(const Light& light, const Point3& point,
 }
 
 std::uint64_t light_sample_seed(const Point3& point, std::uint64_t seed, std::size_t light) {
-    SampleRandom mix(seed ^ (0x9e3779b97f4a7c15ull * (light + 1)));
+    SampleRandom mix(seed ^ (kSplitMixIncrement * (light + 1)));
     std::uint64_t hash = mix.next_bits();
     for (int i = 0; i < 3; ++i) {
         SampleRandom step(hash ^ std::bit_cast<std::uint64_t>(point[i]));

@@ -6,20 +6,11 @@
 
 namespace csgrt {
 
-namespace {
-/// SplitMix64's output function: a bijective mix of 64 bits, used to hash seeds.
-std::uint64_t mix_bits(std::uint64_t z) {
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-}  // namespace
-
 SampleRandom pixel_random(std::uint64_t seed, int x, int y) {
     // Two rounds of mixing so neighbouring pixels and neighbouring seeds get unrelated streams.
     const std::uint64_t pixel = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(y)) << 32) |
                                 static_cast<std::uint32_t>(x);
-    return SampleRandom(mix_bits(mix_bits(pixel) ^ (seed + 0x9e3779b97f4a7c15ull)));
+    return SampleRandom(splitmix_mix(splitmix_mix(pixel) ^ (seed + kSplitMixIncrement)));
 }
 
 StrataGrid strata_for(int samples) {

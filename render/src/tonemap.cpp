@@ -7,22 +7,29 @@
 
 namespace csgrt {
 
+namespace {
+
+/// Each curve with its name in scene files and on the command line: both directions read it.
+struct NamedCurve {
+    ToneCurve curve;
+    std::string_view name;
+};
+constexpr NamedCurve kCurveNames[] = {
+    {ToneCurve::Clamp, "clamp"}, {ToneCurve::Reinhard, "reinhard"}, {ToneCurve::Filmic, "filmic"}};
+
+}  // namespace
+
 ToneCurve parse_tone_curve(std::string_view name) {
-    if (name == "clamp") return ToneCurve::Clamp;
-    if (name == "reinhard") return ToneCurve::Reinhard;
-    if (name == "filmic") return ToneCurve::Filmic;
+    for (const NamedCurve& named : kCurveNames) {
+        if (named.name == name) return named.curve;
+    }
     require(false, "ToneMapping", "curve", "one of clamp, reinhard, filmic", std::string(name));
     return ToneCurve::Filmic;
 }
 
 std::string_view tone_curve_name(ToneCurve curve) {
-    switch (curve) {
-        case ToneCurve::Clamp:
-            return "clamp";
-        case ToneCurve::Reinhard:
-            return "reinhard";
-        case ToneCurve::Filmic:
-            return "filmic";
+    for (const NamedCurve& named : kCurveNames) {
+        if (named.curve == curve) return named.name;
     }
     return "filmic";
 }

@@ -320,10 +320,8 @@ TYPED_TEST(BvhMeshTest, PacketsGiveTheSingleRayAnswersBitForBit) {
 }
 
 TEST(Bvh, PacketSpansOfDifferentSizesThrow) {
-    const TestMesh mesh = test::sphere_mesh(2);
-    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
-    Bvh<TriangleSet<float>> bvh;
-    bvh.build(set);
+    const test::BuiltMesh<float, Bvh> built(test::sphere_mesh(2));
+    const Bvh<TriangleSet<float>>& bvh = built.structure;
     QueryScratch scratch;
     const std::vector<Ray> rays(3);
     std::vector<HitRecord> records(2);

@@ -57,7 +57,7 @@ TYPED_TEST(ReferenceAgreement, BruteForceAgreesWithExactPredicates) {
             test::compare_with_reference(brute, set, reference, ray, scratch, tally);
         }
         tally.print(std::string("brute ") + (sizeof(TypeParam) == 4 ? "float" : "double"));
-        EXPECT_EQ(tally.clear, 0);
+        EXPECT_EQ(tally.disagreements(), 0);
         EXPECT_GT(tally.hits, 10000);
         // Rays aimed exactly at vertices are the ambiguous ones; they must stay a minority.
         EXPECT_LT(tally.ambiguous, tally.rays / 4);

@@ -386,6 +386,21 @@ inline std::vector<Ray> invalid_rays() {
             Ray{Point3(0.5, 0.5, -5), Vector3(0, 0, 1), 0.0, nan}};
 }
 
+/// A triangle set in precision Real built from `mesh`, with brute force over it: the oracle for
+/// tests of the set itself or of structures they build in several ways. Not movable: brute
+/// force points into the set.
+template <class Real>
+struct BruteForceMesh {
+    explicit BruteForceMesh(const TestMesh& mesh) : set(mesh.vertices, mesh.triangles) {
+        brute.build(set);
+    }
+    BruteForceMesh(const BruteForceMesh&) = delete;
+    BruteForceMesh& operator=(const BruteForceMesh&) = delete;
+
+    TriangleSet<Real> set;
+    BruteForce<TriangleSet<Real>> brute;
+};
+
 /// A triangle set in precision Real built from `mesh`, with brute force and a `Structure` built
 /// over it. Not movable: both structures point into the set.
 template <class Real, template <class> class Structure>

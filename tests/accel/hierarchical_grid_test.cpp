@@ -207,9 +207,8 @@ TEST(HierarchicalGrid, TestsFarFewerPrimitivesThanTheRegularGridInTeapotInStadiu
 
 TEST(HierarchicalGrid, CountersAreConsistent) {
     const TestMesh sphere = test::sphere_mesh(6);
-    const TriangleSet<float> set(sphere.vertices, sphere.triangles);
-    HierarchicalGrid<TriangleSet<float>> hgrid;
-    hgrid.build(set);
+    const test::BuiltMesh<float, HierarchicalGrid> built(sphere);
+    const HierarchicalGrid<TriangleSet<float>>& hgrid = built.structure;
     QueryScratch scratch;
     TraversalCounters intersect_counters, occluded_counters;
     const std::vector<Ray> rays = test::camera_rays(test::mesh_bounds(sphere), 2000, 227);

@@ -365,9 +365,8 @@ TYPED_TEST(RayClassificationTest, FarAwayOriginsStillExact) {
 
 TYPED_TEST(RayClassificationTest, TinyMemoryCapStillGivesExactAnswers) {
     const test::TestMesh mesh = test::sphere_mesh(4);
-    const TriangleSet<TypeParam> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(set);
+    const test::BruteForceMesh<TypeParam> oracle(mesh);
+    const auto& [set, brute] = oracle;
     const Aabb box = set_bounds(set);
     std::vector<Ray> rays = camera_rays(box, 3000, 1000);
     const std::vector<Ray> incoherent = incoherent_rays(box, 3000, 1001);
@@ -395,9 +394,8 @@ TYPED_TEST(RayClassificationTest, TinyMemoryCapStillGivesExactAnswers) {
 
 TEST(RayClassification, PrebuildAndBuildDepthGiveTheSameAnswers) {
     const test::TestMesh mesh = test::sphere_mesh(4);
-    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<float>> brute;
-    brute.build(set);
+    const test::BruteForceMesh<float> oracle(mesh);
+    const auto& [set, brute] = oracle;
     const std::vector<Ray> rays = camera_rays(set_bounds(set), 6000, 1100);
 
     RayClassification<TriangleSet<float>> prebuilt;
@@ -446,9 +444,8 @@ TEST(RayClassification, ConcurrentQueriesBuildLazilyAndAgree) {
     // structure that splits at every visit and in one whose small memory cap is reached
     // while they race.
     const test::TestMesh mesh = test::sphere_mesh(4);
-    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<float>> brute;
-    brute.build(set);
+    const test::BruteForceMesh<float> oracle(mesh);
+    const auto& [set, brute] = oracle;
     RayClassification<TriangleSet<float>> eager, capped;
     eager.build(set, RayClassificationConfig{.visits_before_split = 1});
     constexpr std::size_t kCap = 64 * 1024;
@@ -496,9 +493,8 @@ TEST(RayClassification, CellsSplitOnlyWhenRevisited) {
     // huge threshold nothing below the six roots is built, with 1 every cell reached is
     // split; the answers are exact either way.
     const test::TestMesh mesh = test::sphere_mesh(4);
-    const TriangleSet<float> set(mesh.vertices, mesh.triangles);
-    BruteForce<TriangleSet<float>> brute;
-    brute.build(set);
+    const test::BruteForceMesh<float> oracle(mesh);
+    const auto& [set, brute] = oracle;
     const std::vector<Ray> rays = incoherent_rays(set_bounds(set), 3000, 1250);
     RayClassification<TriangleSet<float>> never, lazy, eager;
     never.build(set, RayClassificationConfig{.visits_before_split = 1u << 30});
@@ -625,9 +621,8 @@ TEST(RayClassification, FloatHitsLieWithinTheDocumentedErrorOfTheirBoxes) {
     double worst = 0.0;
     int hits = 0, outside = 0;
     for (const test::TestMesh& mesh : {test::integer_cube(8), triangle_soup(2000, 1801)}) {
-        const TriangleSet<float> set(mesh.vertices, mesh.triangles);
-        BruteForce<TriangleSet<float>> brute;
-        brute.build(set);
+        const test::BruteForceMesh<float> oracle(mesh);
+        const auto& [set, brute] = oracle;
         const Aabb box = set_bounds(set);
         const double largest =
             std::max(box.lower.cwiseAbs().maxCoeff(), box.upper.cwiseAbs().maxCoeff());

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "accel/grid_test_common.h"
 #include "csgrt/accel/brute_force.h"
 #include "support/meshes.h"
 #include "support/precisions.h"
@@ -59,9 +60,8 @@ TYPED_TEST(TriangleSetTest, ClosedMeshNeverLeaksAtSharedEdgesAndVertices) {
     // it, including rays aimed exactly at shared vertices and edge midpoints, where a
     // non-watertight test lets rays slip between neighbours.
     const test::TestMesh cube = test::integer_cube(8);
-    const TriangleSet<TypeParam> set(cube.vertices, cube.triangles);
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(set);
+    const test::BruteForceMesh<TypeParam> oracle(cube);
+    const auto& brute = oracle.brute;
     QueryScratch scratch;
     test::Random random(41);
     int rays = 0;
@@ -92,9 +92,8 @@ TYPED_TEST(TriangleSetTest, ClosedMeshNeverLeaksAtSharedEdgesAndVertices) {
 
 TYPED_TEST(TriangleSetTest, SphereMeshFromInsideNeverLeaks) {
     const test::TestMesh sphere = test::sphere_mesh(4);
-    const TriangleSet<TypeParam> set(sphere.vertices, sphere.triangles);
-    BruteForce<TriangleSet<TypeParam>> brute;
-    brute.build(set);
+    const test::BruteForceMesh<TypeParam> oracle(sphere);
+    const auto& brute = oracle.brute;
     QueryScratch scratch;
     test::Random random(42);
     for (int i = 0; i < 20000; ++i) {

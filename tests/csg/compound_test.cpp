@@ -18,6 +18,7 @@
 #include "csgrt/mesh/mesh.h"
 #include "support/meshes.h"
 #include "support/random.h"
+#include "support/scene_parts.h"
 #include "support/shape_properties.h"
 #include "support/test_scale.h"
 
@@ -28,17 +29,6 @@ using Shapes = std::vector<std::shared_ptr<const Shape>>;
 
 std::shared_ptr<const Shape> sphere(double x, double y, double z, double radius) {
     return std::make_shared<Sphere>(Point3(x, y, z), radius);
-}
-
-CompoundConfig structure(const char* name) {
-    CompoundConfig config;
-    config.accelerator = name;
-    return config;
-}
-
-// The unbounded ground y = 0, an open surface.
-std::shared_ptr<const Shape> ground_plane() {
-    return std::make_shared<Plane>(Point3(0, 0, 0), Normal3(0, 1, 0));
 }
 
 // Test fixture: forwards to a shape and counts the nearest_hit and any_hit calls it receives.
@@ -129,7 +119,7 @@ TEST(Compound, EqualTGoesToTheLowerChildIndex) {
         Shapes children = disjoint_spheres(2, 5);
         children.push_back(sphere(20, 0, 0, 1));
         children.push_back(sphere(20, 0, 0, 1));
-        const Compound compound(children, structure(name));
+        const Compound compound(children, test::structure_named<CompoundConfig>(name));
         const auto hit = compound.intersect(Ray{Point3(20, 0, -5), Vector3(0, 0, 1)});
         ASSERT_TRUE(hit) << name;
         EXPECT_EQ(hit->object_id, 8u) << name;
@@ -152,7 +142,7 @@ TEST(Compound, IntervalIsHonouredAtBothEnds) {
 }
 
 TEST(Compound, UnboundedChildrenAreAskedOnEveryRayAndTieByIndex) {
-    auto ground = ground_plane();
+    auto ground = test::ground_plane();
     const Compound compound({sphere(0, 1, 0, 1), ground, sphere(5, 3, 0, 1)});
     EXPECT_FALSE(compound.bounds().is_finite());
     // Straight down onto the sphere that rests on the ground: the sphere first.
@@ -183,28 +173,30 @@ TEST(Compound, UnboundedChildrenAreAskedOnEveryRayAndTieByIndex) {
 
 TEST(Compound, SolidOnlyWhenEveryChildIsASolid) {
     EXPECT_TRUE(Compound({sphere(0, 0, 0, 1), sphere(3, 0, 0, 1)}).is_solid());
-    EXPECT_FALSE(Compound({sphere(0, 0, 0, 1), ground_plane()}).is_solid());
+    EXPECT_FALSE(Compound({sphere(0, 0, 0, 1), test::ground_plane()}).is_solid());
     EXPECT_FALSE(Compound(Shapes{}).is_solid());
     const Compound empty{Shapes{}};
     EXPECT_FALSE(empty.intersect(Ray{Point3(0, 0, 0), Vector3(1, 0, 0)}));
     EXPECT_TRUE(empty.bounds().is_empty());
     EXPECT_EQ(empty.accelerator_name(), "");
     // A non-solid compound is no CSG operand.
-    EXPECT_THROW(Boolean(BooleanOperation::Union, sphere(0, 0, 0, 1),
-                         std::make_shared<Compound>(Shapes{sphere(0, 0, 0, 1), ground_plane()})),
-                 InvalidParameter);
+    EXPECT_THROW(
+        Boolean(BooleanOperation::Union, sphere(0, 0, 0, 1),
+                std::make_shared<Compound>(Shapes{sphere(0, 0, 0, 1), test::ground_plane()})),
+        InvalidParameter);
 }
 
 TEST(Compound, BadArgumentsThrow) {
     EXPECT_THROW(Compound({sphere(0, 0, 0, 1), nullptr}), InvalidParameter);
-    EXPECT_THROW(Compound({sphere(0, 0, 0, 1)}, structure("octree")), InvalidParameter);
+    EXPECT_THROW(Compound({sphere(0, 0, 0, 1)}, test::structure_named<CompoundConfig>("octree")),
+                 InvalidParameter);
     EXPECT_THROW(make_hierarchy({}), InvalidParameter);
     EXPECT_THROW(make_hierarchy({sphere(0, 0, 0, 1)}, 1), InvalidParameter);
     EXPECT_THROW(make_hierarchy({sphere(0, 0, 0, 1), nullptr}), InvalidParameter);
 }
 
 TEST(Compound, InvalidRaysHitNothing) {
-    const Compound compound({sphere(0, 0, 0, 1), ground_plane()});
+    const Compound compound({sphere(0, 0, 0, 1), test::ground_plane()});
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (const Ray& ray :
          {Ray{Point3(nan, 0, 0), Vector3(0, 0, 1)}, Ray{Point3(0, 0, -5), Vector3(0, kInfinity, 1)},
@@ -393,8 +385,8 @@ TEST(Compound, StructuresAndHierarchiesGiveTheSameHitsAsBruteForce) {
         spheres.push_back(sphere(random.uniform(-50, 50), random.uniform(-50, 50),
                                  random.uniform(-50, 50), random.uniform(0.2, 3.0)));
     }
-    spheres.push_back(ground_plane());
-    const Compound brute(spheres, structure("brute"));
+    spheres.push_back(test::ground_plane());
+    const Compound brute(spheres, test::structure_named<CompoundConfig>("brute"));
     const Compound automatic(spheres);
     const auto hierarchy = make_hierarchy(spheres, 4);
     const auto binary = make_hierarchy(spheres, 2);
@@ -426,7 +418,7 @@ TEST(Compound, HierarchyTestsFarFewerChildren) {
     Shapes counted;
     for (const auto& s : disjoint_spheres(12, 4))
         counted.push_back(std::make_shared<Counted>(s, calls));
-    const Compound flat(counted, structure("brute"));
+    const Compound flat(counted, test::structure_named<CompoundConfig>("brute"));
     const auto hierarchy = make_hierarchy(counted, 4);
     test::Random random(2);
     const Aabb region(Point3(-1, -1, -1), Point3(23, 23, 23));

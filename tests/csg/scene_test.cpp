@@ -16,21 +16,11 @@
 #include "csgrt/csg/boolean.h"
 #include "csgrt/csg/compound.h"
 #include "support/random.h"
+#include "support/scene_parts.h"
 #include "support/test_output.h"
 
 namespace csgrt {
 namespace {
-
-SceneConfig structure(const char* name) {
-    SceneConfig config;
-    config.accelerator = name;
-    return config;
-}
-
-// The unbounded ground y = 0, an open surface.
-std::shared_ptr<const Shape> ground_plane() {
-    return std::make_shared<Plane>(Point3(0, 0, 0), Normal3(0, 1, 0));
-}
 
 // The example of docs/scene.md, verbatim between the markers: a 20-object scene in C++.
 Scene docs_example() {
@@ -103,7 +93,7 @@ TEST(Scene, ObjectIdsNameTheObjectAndTiesGoToTheLowerIndex) {
     Scene scene;
     auto a = std::make_shared<Sphere>(Point3(0, 1, 0), 1.0);
     scene.add_object(std::make_shared<Sphere>(Point3(5, 1, 0), 1.0));  // 0
-    scene.add_object(ground_plane());                                  // 1
+    scene.add_object(test::ground_plane());                            // 1
     scene.add_object(a);                                               // 2
     scene.add_object(a);                                               // 3: the same sphere
     scene.commit();
@@ -141,7 +131,7 @@ TEST(Scene, LifecycleAndValidation) {
     scene.add_object(std::make_shared<Sphere>(Point3(0, 0, 5), 1.0));
     EXPECT_FALSE(scene.is_committed());
     EXPECT_FALSE(scene.intersect(ray, scratch));
-    scene.commit(structure("brute"));
+    scene.commit(test::structure_named<SceneConfig>("brute"));
     EXPECT_EQ(scene.intersect(ray, scratch)->object_id, 1u);
     EXPECT_EQ(scene.accelerator_name(), "brute");
 
@@ -149,7 +139,7 @@ TEST(Scene, LifecycleAndValidation) {
     EXPECT_THROW(scene.add_object(std::make_shared<Sphere>(Point3(0, 0, 0), 1.0), 7),
                  InvalidParameter);
     EXPECT_THROW(scene.add_material(Material{"hot", {1.5, 0, 0}}), InvalidParameter);
-    EXPECT_THROW(scene.commit(structure("octree")), InvalidParameter);
+    EXPECT_THROW(scene.commit(test::structure_named<SceneConfig>("octree")), InvalidParameter);
     EXPECT_FALSE(scene.is_committed());
     Camera camera;
     camera.look_at = camera.position;
@@ -166,7 +156,7 @@ TEST(Scene, LifecycleAndValidation) {
 TEST(Scene, InvalidRaysHitNothing) {
     Scene scene;
     scene.add_object(std::make_shared<Sphere>(Point3(0, 0, 0), 1.0));
-    scene.add_object(ground_plane());
+    scene.add_object(test::ground_plane());
     scene.commit();
     QueryScratch scratch;
     const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -207,7 +197,7 @@ RandomScene random_scene(std::uint64_t seed) {
                     std::make_shared<Compound>(std::vector<std::shared_ptr<const Shape>>{
                         ball, std::make_shared<Sphere>(c + Vector3(0, 2 * r, 0), 0.5 * r)}));
         }
-        if (i == 150) shapes.push_back(ground_plane());
+        if (i == 150) shapes.push_back(test::ground_plane());
     }
     RandomScene result;
     for (const auto& shape : shapes) {
@@ -215,7 +205,7 @@ RandomScene random_scene(std::uint64_t seed) {
         result.brute.add_object(shape);
     }
     result.scene.commit();
-    result.brute.commit(structure("brute"));
+    result.brute.commit(test::structure_named<SceneConfig>("brute"));
     return result;
 }
 
@@ -331,7 +321,7 @@ TEST(Scene, CommitBuildsTheCompoundsLeftToItWithItsConfiguration) {
     auto left_default = std::make_shared<const Compound>(row_of_spheres(), deferred);
     Scene plain;
     plain.add_object(left_default);
-    plain.commit(structure("grid"));
+    plain.commit(test::structure_named<SceneConfig>("grid"));
     EXPECT_EQ(left_default->accelerator_name(), "grid");
     EXPECT_GT(left_default->accelerator_stats().nodes, 1u);
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "csgrt/accel/factory.h"
@@ -13,6 +14,7 @@
 #include "csgrt/core/sphere.h"
 #include "csgrt/csg/compound.h"
 #include "support/random.h"
+#include "support/scene_parts.h"
 
 namespace csgrt {
 namespace {
@@ -58,10 +60,6 @@ public:
     bool contains(const Point3&) const override { return false; }
 };
 
-std::shared_ptr<const Shape> ground(double height) {
-    return std::make_shared<Plane>(Point3(0, height, 0), Normal3(0, 1, 0));
-}
-
 // The exact repeats among mixed_members' spheres (i = 3, 10, 17, 24), which a group drops.
 constexpr std::size_t kMixedRepeats = 4;
 
@@ -70,14 +68,14 @@ constexpr std::size_t kMixedRepeats = 4;
 Shapes mixed_members(std::uint64_t seed) {
     test::Random random(seed);
     Shapes members;
-    members.push_back(ground(-3.0));
+    members.push_back(test::ground_plane(-3.0));
     members.push_back(std::make_shared<Nothing>());
     for (int i = 0; i < 30; ++i) {
         const Point3 centre = random.in_box(Aabb(Point3(-4, -2, -4), Point3(4, 2, 4)));
         members.push_back(std::make_shared<Sphere>(centre, random.uniform(0.2, 1.0)));
         if (i % 7 == 3) members.push_back(members.back());
     }
-    members.push_back(ground(3.5));
+    members.push_back(test::ground_plane(3.5));
     return members;
 }
 
@@ -96,6 +94,23 @@ bool nearest_by_loop(const Shapes& members, const Ray& ray, HitRecord& best) {
         found = true;
     }
     return found;
+}
+
+// Checks the group's nearest and any for `ray` (the k-th ray) against the loop's: the same
+// shapes asked the same ray, so identical to the bit. `loop_hit` receives the loop's nearest
+// hit. A hit/miss disagreement is fatal: call under ASSERT_NO_FATAL_FAILURE.
+void expect_group_agrees_with_loop(const ShapeGroup& group, const Shapes& members, const Ray& ray,
+                                   int k, QueryScratch& scratch,
+                                   std::optional<HitRecord>& loop_hit) {
+    HitRecord expected, actual;
+    const bool found = nearest_by_loop(members, ray, expected);
+    loop_hit.reset();
+    ASSERT_EQ(group.nearest(ray, actual, scratch), found) << k;
+    EXPECT_EQ(group.any(ray, scratch), found) << k;
+    if (!found) return;
+    loop_hit = expected;
+    EXPECT_EQ(actual.t, expected.t) << k;
+    EXPECT_EQ(actual.object, expected.object) << k;
 }
 
 TEST(ShapeGroup, SplitsMembersIntoBoundedAndUnboundedAndDropsEmptyOnes) {
@@ -126,20 +141,17 @@ TEST(ShapeGroup, EveryStructureGivesTheLoopsNearestAnyAndAllHits) {
         for (int k = 0; k < 400; ++k) {
             const Point3 origin = random.in_box(Aabb(Point3(-6, -5, -6), Point3(6, 5, 6)));
             const Ray ray{origin, random.unit_vector()};
-            HitRecord expected, actual;
-            const bool found = nearest_by_loop(members, ray, expected);
-            ASSERT_EQ(group.nearest(ray, actual, scratch), found) << k;
-            EXPECT_EQ(group.any(ray, scratch), found) << k;
+            std::optional<HitRecord> expected;
+            ASSERT_NO_FATAL_FAILURE(
+                expect_group_agrees_with_loop(group, members, ray, k, scratch, expected));
             TraversalCounters counters;
             HitRecord counted;
-            ASSERT_EQ(group.nearest_counted(ray, counted, scratch, counters), found) << k;
-            if (found) {
+            ASSERT_EQ(group.nearest_counted(ray, counted, scratch, counters), expected.has_value())
+                << k;
+            if (expected) {
                 ++hits;
-                // The same shapes asked the same rays: identical, to the bit.
-                EXPECT_EQ(actual.t, expected.t) << k;
-                EXPECT_EQ(actual.object, expected.object) << k;
-                EXPECT_EQ(counted.t, expected.t) << k;
-                EXPECT_EQ(counted.object, expected.object) << k;
+                EXPECT_EQ(counted.t, expected->t) << k;
+                EXPECT_EQ(counted.object, expected->object) << k;
                 EXPECT_GE(counters.primitives_tested, group.unbounded().size()) << k;
             }
             std::vector<HitRecord> all;
@@ -163,7 +175,7 @@ TEST(ShapeGroup, EveryStructureGivesTheLoopsNearestAnyAndAllHits) {
 }
 
 TEST(ShapeGroup, ATieBetweenABoundedAndAnUnboundedMemberGoesToTheLowerIndex) {
-    const auto plane = ground(0.0);
+    const auto plane = test::ground_plane(0.0);
     const auto boxed = std::make_shared<BoxedPlane>(plane);
     const Ray down{Point3(0.25, 5, -0.5), Vector3(0.1, -1, 0.2)};
     QueryScratch scratch;
@@ -226,14 +238,9 @@ TEST(ShapeGroup, ExactRepeatsAreDroppedAndTheNearestHitIsTheLoops) {
         QueryScratch scratch;
         for (int k = 0; k < 200; ++k) {
             const Point3 origin = random.in_box(Aabb(Point3(-4, -4, -4), Point3(4, 4, 4)));
-            const Ray ray{origin, random.unit_vector()};
-            HitRecord expected, actual;
-            const bool found = nearest_by_loop(members, ray, expected);
-            ASSERT_EQ(group.nearest(ray, actual, scratch), found) << k;
-            EXPECT_EQ(group.any(ray, scratch), found) << k;
-            if (!found) continue;
-            EXPECT_EQ(actual.t, expected.t) << k;
-            EXPECT_EQ(actual.object, expected.object) << k;
+            std::optional<HitRecord> expected;
+            ASSERT_NO_FATAL_FAILURE(expect_group_agrees_with_loop(
+                group, members, Ray{origin, random.unit_vector()}, k, scratch, expected));
         }
     }
     // 4096 coincident copies, each its own Instance, cost one primitive test a ray.
@@ -250,8 +257,8 @@ TEST(ShapeGroup, ExactRepeatsAreDroppedAndTheNearestHitIsTheLoops) {
 }
 
 TEST(ShapeGroup, RejectsANullMemberAndAnUnknownStructure) {
-    EXPECT_THROW(ShapeGroup(Shapes{ground(0), nullptr}, "auto", {}), InvalidParameter);
-    EXPECT_THROW(ShapeGroup(Shapes{ground(0)}, "octree", {}), InvalidParameter);
+    EXPECT_THROW(ShapeGroup(Shapes{test::ground_plane(0), nullptr}, "auto", {}), InvalidParameter);
+    EXPECT_THROW(ShapeGroup(Shapes{test::ground_plane(0)}, "octree", {}), InvalidParameter);
 }
 
 }  // namespace

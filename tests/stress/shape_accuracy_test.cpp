@@ -20,8 +20,9 @@
 #include "stress/reference_judge.h"
 #include "stress/reference_shapes.h"
 #include "stress/stress_config.h"
-#include "support/example_shapes.h"
 #include "stress/summary.h"
+#include "support/answer_tally.h"
+#include "support/example_shapes.h"
 #include "support/random.h"
 
 namespace csgrt {
@@ -113,42 +114,24 @@ std::vector<Case> all_cases() {
     return cases;
 }
 
-struct Tally {
-    long rays = 0;
-    long reference_hits = 0;
-    long ambiguous = 0;
-    long false_hits = 0;
-    long false_misses = 0;
-    long wrong_t = 0;
+/// The answers of one case (or of all the cases of a kind) against the long double model, with
+/// the checks a shape's own answers get beyond intersect's.
+struct Tally : test::AnswerTally {
     long span_rays = 0;
     long span_failures = 0;
     long any_hit_disagreements = 0;
-    /// Relative t error over hits with |cos| >= 0.1 where the ray travels at least as far as
-    /// the coordinates of its origin and of the object are large (otherwise those, not t,
-    /// set the rounding, and the point scales below are the measure).
-    double max_relative_error = 0.0;
     /// The error as the backward error it amounts to: |t - t_ref| |d| cos / s(t), in point
     /// scales (the bound allows kRootUlps).
     double max_point_scales = 0.0;
-    double max_ratio = 0.0;  // error / bound over all judged hits
 
     void add(const Tally& other) {
-        rays += other.rays;
-        reference_hits += other.reference_hits;
-        ambiguous += other.ambiguous;
-        false_hits += other.false_hits;
-        false_misses += other.false_misses;
-        wrong_t += other.wrong_t;
+        AnswerTally::add(other);
         span_rays += other.span_rays;
         span_failures += other.span_failures;
         any_hit_disagreements += other.any_hit_disagreements;
-        max_relative_error = std::max(max_relative_error, other.max_relative_error);
         max_point_scales = std::max(max_point_scales, other.max_point_scales);
-        max_ratio = std::max(max_ratio, other.max_ratio);
     }
-    long failures() const {
-        return false_hits + false_misses + wrong_t + span_failures + any_hit_disagreements;
-    }
+    long failures() const { return disagreements() + span_failures + any_hit_disagreements; }
 };
 
 std::string describe(const Case& c, const Ray& ray) {
@@ -193,6 +176,9 @@ std::optional<Hit> check_ray(const Case& c, const Ray& ray, Tally& tally) {
             tally.max_point_scales =
                 std::max(tally.max_point_scales,
                          error * ray.direction.norm() * cosine / point_scale(ray, t, c));
+            // The relative error only over hits with |cos| >= 0.1 where the ray travels at
+            // least as far as the coordinates of its origin and of the object are large
+            // (otherwise those, not t, set the rounding, and the point scales are the measure).
             const double travel = std::abs(t) * ray.direction.norm();
             if (cosine >= 0.1 && travel >= ray.origin.norm() + c.center.norm()) {
                 tally.max_relative_error = std::max(tally.max_relative_error, error / std::abs(t));

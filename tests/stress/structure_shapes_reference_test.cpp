@@ -45,6 +45,7 @@
 #include "stress/reference_booleans.h"
 #include "stress/reference_judge.h"
 #include "stress/summary.h"
+#include "support/answer_tally.h"
 #include "support/example_shapes.h"
 #include "support/random.h"
 #include "support/test_scale.h"
@@ -146,27 +147,10 @@ std::vector<GroupCase> all_cases() {
     return cases;
 }
 
-struct Tally {
-    long rays = 0;
-    long ambiguous = 0;
-    long reference_hits = 0;
-    long disagreements = 0;
-    double max_relative_error = 0.0;  // |t - t_ref| / t_ref over judged hits
-    double max_ratio = 0.0;           // error / bound
-};
-
-void add_to(Tally& total, const Tally& tally) {
-    total.rays += tally.rays;
-    total.ambiguous += tally.ambiguous;
-    total.reference_hits += tally.reference_hits;
-    total.disagreements += tally.disagreements;
-    total.max_relative_error = std::max(total.max_relative_error, tally.max_relative_error);
-    total.max_ratio = std::max(total.max_ratio, tally.max_ratio);
-}
-
 /// `rays` rays at the group `c` under every registered structure, each judged once against the
 /// reference; prints the case's row and returns its tally.
-Tally check_case(const GroupCase& c, int rays, std::uint64_t seed, bool must_agree = true) {
+test::AnswerTally check_case(const GroupCase& c, int rays, std::uint64_t seed,
+                             bool must_agree = true) {
     const auto names = accelerator_names();
     std::vector<std::shared_ptr<const Compound>> structures;
     for (const std::string_view name : names) {
@@ -175,7 +159,7 @@ Tally check_case(const GroupCase& c, int rays, std::uint64_t seed, bool must_agr
         structures.push_back(std::make_shared<Compound>(c.members, config));
     }
     test::Random random(seed);
-    Tally tally;
+    test::AnswerTally tally;
     const double size = (c.target.upper - c.target.lower).norm();
     for (int i = 0; i < rays; ++i) {
         Ray ray;
@@ -203,9 +187,12 @@ Tally check_case(const GroupCase& c, int rays, std::uint64_t seed, bool must_agr
         if (verdict.hit) ++tally.reference_hits;
         for (std::size_t s = 0; s < structures.size(); ++s) {
             const std::optional<Hit> hit = structures[s]->intersect(ray);
-            bool agrees =
-                hit.has_value() == verdict.hit && structures[s]->occluded(ray) == hit.has_value();
-            if (agrees && hit) {
+            // The count this structure's answer adds to if it disagrees: intersect's or
+            // occluded's hit/miss, else intersect's t.
+            long* disagreement = nullptr;
+            if (hit.has_value() != verdict.hit || structures[s]->occluded(ray) != verdict.hit) {
+                disagreement = verdict.hit ? &tally.false_misses : &tally.false_hits;
+            } else if (hit) {
                 const double t = static_cast<double>(verdict.t);
                 const double error = std::abs(hit->t - t);
                 const double bound =
@@ -213,10 +200,11 @@ Tally check_case(const GroupCase& c, int rays, std::uint64_t seed, bool must_agr
                 tally.max_ratio = std::max(tally.max_ratio, error / bound);
                 if (t > 0.0)
                     tally.max_relative_error = std::max(tally.max_relative_error, error / t);
-                agrees = error <= bound;
+                if (error > bound) disagreement = &tally.wrong_t;
             }
-            if (!agrees) {
-                if (++tally.disagreements <= 5 && must_agree) {
+            if (disagreement) {
+                ++*disagreement;
+                if (tally.disagreements() <= 5 && must_agree) {
                     ADD_FAILURE() << c.name << " under " << names[s] << ": hit "
                                   << (hit ? hit->t : -1.0) << ", reference "
                                   << (verdict.hit ? static_cast<double>(verdict.t) : -1.0)
@@ -229,14 +217,14 @@ Tally check_case(const GroupCase& c, int rays, std::uint64_t seed, bool must_agr
     }
     std::printf("  | %s | %zu | %ld | %ld | %ld | %ld | %.1e | %.3f |\n", c.name.c_str(),
                 structures.size(), tally.rays, tally.ambiguous, tally.reference_hits,
-                tally.disagreements, tally.max_relative_error, tally.max_ratio);
+                tally.disagreements(), tally.max_relative_error, tally.max_ratio);
     if (!must_agree) return tally;
-    EXPECT_EQ(tally.disagreements, 0) << c.name;
+    EXPECT_EQ(tally.disagreements(), 0) << c.name;
     // The check must bite: most rays are judged, and at least a thousandth hit (the thin
     // tori under shear are hit by 0.16 % of the rays aimed at their boxes).
     EXPECT_LT(tally.ambiguous, tally.rays / 10) << c.name;
     EXPECT_GT(tally.reference_hits, tally.rays / 1000) << c.name;
-    test::summarize(c.name + " under every structure", tally.rays, tally.disagreements,
+    test::summarize(c.name + " under every structure", tally.rays, tally.disagreements(),
                     tally.max_relative_error, "rel t");
     return tally;
 }
@@ -247,19 +235,19 @@ void print_header() {
         " | max rel t error | worst error / bound |\n");
 }
 
-void print_total(const Tally& total, std::size_t cases) {
+void print_total(const test::AnswerTally& total, std::size_t cases) {
     std::printf("  | all (%zu cases) | %zu | %ld | %ld | %ld | %ld | %.1e | %.3f |\n\n", cases,
                 accelerator_names().size(), total.rays, total.ambiguous, total.reference_hits,
-                total.disagreements, total.max_relative_error, total.max_ratio);
+                total.disagreements(), total.max_relative_error, total.max_ratio);
 }
 
 TEST(StructureShapesReferenceHeavy, EveryShapeUnderEveryStructureAgainstLongDouble) {
     const int rays = test::scaled(100000, 2000);
     const std::vector<GroupCase> cases = all_cases();
     print_header();
-    Tally total;
+    test::AnswerTally total;
     std::uint64_t seed = 16000;
-    for (const GroupCase& c : cases) add_to(total, check_case(c, rays, ++seed));
+    for (const GroupCase& c : cases) total.add(check_case(c, rays, ++seed));
     print_total(total, cases.size());
 }
 
@@ -365,8 +353,8 @@ std::vector<GroupCase> boolean_cases(SolidsTaken taken) {
 void check_cases(const std::vector<GroupCase>& cases, std::uint64_t seed) {
     const int rays = test::scaled(100000, 2000);
     print_header();
-    Tally total;
-    for (const GroupCase& c : cases) add_to(total, check_case(c, rays, ++seed));
+    test::AnswerTally total;
+    for (const GroupCase& c : cases) total.add(check_case(c, rays, ++seed));
     print_total(total, cases.size());
 }
 
@@ -403,8 +391,8 @@ TEST(StructureShapesReferenceHeavy, ReadyMadeCompoundsAndPlacedBooleansUnderEver
     const GroupCase wrong =
         group_of("control: box minus a ball judged as the box", bitten_box->members.front(),
                  box->judged.reference, box->judged, box->target);
-    const Tally control = check_case(wrong, test::scaled(10000, 2000), 16999, false);
-    EXPECT_GT(control.disagreements, control.rays / 20);
+    const test::AnswerTally control = check_case(wrong, test::scaled(10000, 2000), 16999, false);
+    EXPECT_GT(control.disagreements(), control.rays / 20);
 }
 
 TEST(StructureShapesReferenceHeavy, BooleansOfEverySolidUnderEveryStructure) {

@@ -13,28 +13,26 @@
 #include "csgrt/accel/accelerator.h"
 #include "csgrt/accel/triangle_set.h"
 #include "csgrt/reference/cgal_reference.h"
+#include "support/answer_tally.h"
 
 namespace csgrt::test {
 
-/// Tallies of one structure's answers against CGAL's exact predicates.
-struct ReferenceTally {
-    long rays = 0;
+/// Tallies of one structure's answers against CGAL's exact predicates. Its ambiguous answers
+/// are disagreements on hit/miss or on the nearest primitive where the ray passes within the
+/// ambiguity band of an edge: expected at the precision used; counted and printed. A nearest
+/// hit on another primitive at another point (beyond the band) counts as a wrong t.
+struct ReferenceTally : AnswerTally {
+    /// The structure's hits.
     long hits = 0;
-    /// Disagreements on hit/miss or on the nearest primitive where the ray passes within the
-    /// ambiguity band of an edge: expected at the precision used; counted and printed.
-    long ambiguous = 0;
     /// Hits on another primitive than the reference's at the same point (to the band): a
     /// shared edge or vertex, or a ray along a face. Right answers; counted apart.
     long tied = 0;
-    /// Disagreements outside the band: bugs. Must be zero.
-    long clear = 0;
-    double max_relative_t_error = 0.0;
 
     void print(const std::string& label) const {
         std::printf(
             "[reference] %-40s rays %ld hits %ld tied %ld ambiguous %ld clear %ld max rel t err "
             "%.3g\n",
-            label.c_str(), rays, hits, tied, ambiguous, clear, max_relative_t_error);
+            label.c_str(), rays, hits, tied, ambiguous, disagreements(), max_relative_error);
     }
 };
 
@@ -108,6 +106,7 @@ void judge_against_reference(const TriangleSet<Real>& set, const CgalReference& 
                              ReferenceTally& tally, bool t_must_agree = false) {
     ++tally.rays;
     if (hit) ++tally.hits;
+    if (exact) ++tally.reference_hits;
     auto in_band = [&](std::uint32_t primitive) {
         return distance_to_boundary(set, primitive, ray) <= ambiguity_band(set, primitive, ray);
     };
@@ -123,7 +122,7 @@ void judge_against_reference(const TriangleSet<Real>& set, const CgalReference& 
             std::printf("hitmiss hit=%d prim=%u dist=%Lg band=%Lg\n", hit, primitive,
                         distance_to_boundary(set, primitive, ray),
                         ambiguity_band(set, primitive, ray));
-        (ambiguous ? tally.ambiguous : tally.clear)++;
+        (ambiguous ? tally.ambiguous : hit ? tally.false_hits : tally.false_misses)++;
         return;
     }
     if (!hit) return;
@@ -139,16 +138,16 @@ void judge_against_reference(const TriangleSet<Real>& set, const CgalReference& 
         if (!ambiguous && std::getenv("CSGRT_DEBUG_REFERENCE"))
             std::printf("prim %u vs %u t %.17g vs %.17g gap %g\n", record.primitive,
                         exact->primitive, record.t, exact->t, gap);
-        (ambiguous ? tally.ambiguous : tally.clear)++;
+        (ambiguous ? tally.ambiguous : tally.wrong_t)++;
         return;
     }
     const double error = std::abs(record.t - exact->t) / std::max(1e-300, std::abs(exact->t));
-    tally.max_relative_t_error = std::max(tally.max_relative_t_error, error);
+    tally.max_relative_error = std::max(tally.max_relative_error, error);
     const double distance = std::abs(record.t - exact->t) * ray.direction.norm();
     if (distance > ambiguity_band(set, exact->primitive, ray)) {
         if (std::getenv("CSGRT_DEBUG_REFERENCE"))
             std::printf("t %.17g vs %.17g err %g\n", record.t, exact->t, error);
-        ++tally.clear;
+        ++tally.wrong_t;
     }
 }
 

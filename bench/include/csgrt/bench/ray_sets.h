@@ -10,24 +10,18 @@
 #include "csgrt/core/math.h"
 #include "csgrt/core/ray.h"
 #include "csgrt/csg/camera.h"
+#include "csgrt/render/sampling.h"
 
 namespace csgrt::bench {
 
-/// Seeded random numbers that are the same on every platform (splitmix64; Steele, Lea and
-/// Flood, "Fast Splittable Pseudorandom Number Generators", OOPSLA 2014), so a ray set is
-/// fixed by its seed alone, unlike the standard distributions, whose algorithms vary.
-class SplitMix {
+/// Seeded random numbers that are the same on every platform (SampleRandom's SplitMix64), so a
+/// ray set is fixed by its seed alone, unlike the standard distributions, whose algorithms
+/// vary; with the ranges, directions and points ray sets draw.
+class SplitMix : public SampleRandom {
 public:
-    explicit SplitMix(std::uint64_t seed) : state_(seed) {}
+    using SampleRandom::SampleRandom;
+    using SampleRandom::uniform;
 
-    std::uint64_t next() {
-        std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ULL);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-        return z ^ (z >> 31);
-    }
-    /// Uniform in [0, 1): the top 53 bits, exactly representable.
-    double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
     double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
     /// Uniform on the unit sphere (Archimedes: z uniform in [-1, 1], azimuth uniform).
     Vector3 unit_vector() {
@@ -40,9 +34,6 @@ public:
         return {uniform(box.lower.x(), box.upper.x()), uniform(box.lower.y(), box.upper.y()),
                 uniform(box.lower.z(), box.upper.z())};
     }
-
-private:
-    std::uint64_t state_;
 };
 
 /// A named, fixed list of rays; camera rays also keep the image size (row-major pixels).

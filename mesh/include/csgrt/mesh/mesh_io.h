@@ -106,6 +106,11 @@ TriangleMeshData load_mesh(const std::filesystem::path& path, MeshReport* report
 /// Throws InvalidParameter for a non-finite vertex, an out-of-range index, or no triangle left.
 MeshReport validate_mesh(TriangleMeshData& mesh);
 
+/// validate_mesh again on a mesh read from a file (after triangulating it or welding its
+/// vertices): the report keeps from `as_read` what only reading the file could find, its format
+/// and its faces as stored, dropped, triangulated and not simple.
+MeshReport validate_mesh(TriangleMeshData& mesh, const MeshReport& as_read);
+
 /// Writes `mesh` as binary little-endian PLY (float coordinates, int indices): the cache
 /// format of the mesh generator. Throws MeshError when the file cannot be written.
 void save_mesh(const std::filesystem::path& path, const TriangleMeshData& mesh);

@@ -6,19 +6,23 @@
 
 namespace csgrt {
 
+/// SplitMix64 (Steele, Lea and Flood, "Fast Splittable Pseudorandom Number Generators", OOPSLA
+/// 2014): the increment of its state, 2^64 over the golden ratio, and its output function, a
+/// bijective mix of 64 bits (also used to hash seeds).
+inline constexpr std::uint64_t kSplitMixIncrement = 0x9e3779b97f4a7c15ull;
+inline std::uint64_t splitmix_mix(std::uint64_t z) {
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
 /// A small random generator whose sequence is the same on every platform and compiler (the
-/// std distributions are not): SplitMix64 (Steele, Lea and Flood, "Fast Splittable
-/// Pseudorandom Number Generators", OOPSLA 2014).
+/// std distributions are not): SplitMix64.
 class SampleRandom {
 public:
     explicit SampleRandom(std::uint64_t seed) : state_(seed) {}
 
-    std::uint64_t next_bits() {
-        std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return z ^ (z >> 31);
-    }
+    std::uint64_t next_bits() { return splitmix_mix(state_ += kSplitMixIncrement); }
 
     /// Uniform in [0, 1): the top 53 bits scaled by 2^-53, so 1 is never returned.
     double uniform() { return static_cast<double>(next_bits() >> 11) * 0x1.0p-53; }
