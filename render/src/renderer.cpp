@@ -252,6 +252,8 @@ void render_pixel(const Frame& frame, int x, int y, Pixel& pixel, QueryScratch& 
 
     // The AOVs come from one ray through the pixel centre (with one sample, also its colour).
     const Ray centre = centre_ray(frame, x, y);
+    // The image's memory holds nothing yet (Image::for_writing): the background's AOVs first.
+    pixel = Pixel{};
     TraversalCounters counters;
     QueryCost cost;
     cost.solves_by_kind = &tally.solves_by_kind;
@@ -368,7 +370,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings) {
     scene.camera().validate();
 
     const auto start = std::chrono::steady_clock::now();
-    RenderResult result{Image(settings.width, settings.height), {}};
+    // render_pixel writes every pixel whole.
+    RenderResult result{Image::for_writing(settings.width, settings.height), {}};
     const Frame frame{scene, settings,
                       CameraFilm(scene.camera(), double(settings.width) / settings.height),
                       strata_for(settings.samples_per_pixel)};
