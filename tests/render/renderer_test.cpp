@@ -1,11 +1,14 @@
 #include "csgrt/render/renderer.h"
 
 #include <gtest/gtest.h>
+#include <malloc.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <mutex>
 #include <vector>
 
@@ -330,6 +333,38 @@ TEST(Render, OutputDoesNotDependOnThreadsOrTiles) {
     // The seed does change the jitter, so the comparison above can fail.
     settings.seed = 1;
     EXPECT_FALSE(same_pixels(one.image, render(scene, settings).image, true));
+}
+
+// The renderer's image is not filled before rendering (Image::for_writing): every pixel must
+// be written whole. glibc's M_PERTURB fills each new heap block with the complement of its
+// byte, so the image below starts as garbage (0xa5 bytes: NaNs and ids that are no object);
+// it must come out byte for byte as the render into whatever the heap held before.
+TEST(Render, EveryPixelIsWrittenWholeWhateverTheImagesMemoryHeld) {
+    Scene scene = test::spheres_on_a_plane();
+    scene.commit();
+    // 40 x 30 pixels of 52 bytes: a heap block well below glibc's mmap threshold (128 KiB),
+    // which M_PERTURB reaches (mapped blocks come zeroed from the kernel).
+    const RenderSettings settings = test::settings_of_size(40, 30, 1);
+    const Image reference = render(scene, settings).image;
+    // Under ASan and TSan, whose allocators ignore mallopt, ASan's own fill of new blocks
+    // (0xbe, their first 4 KiB) is what the image starts as.
+    mallopt(M_PERTURB, 0x5a);
+    const Image image = render(scene, settings).image;
+    mallopt(M_PERTURB, 0);
+    ASSERT_EQ(image.pixel_count(), reference.pixel_count());
+    static_assert(sizeof(Pixel) == 13 * sizeof(float), "Pixel has no padding to compare");
+    int background = 0;
+    for (std::size_t i = 0; i < image.pixel_count(); ++i) {
+        const Pixel& pixel = image.pixels()[i];
+        ASSERT_EQ(std::memcmp(&pixel, &reference.pixels()[i], sizeof(Pixel)), 0) << "pixel " << i;
+        if (pixel.object_id == kNoIndex) {
+            ++background;
+            EXPECT_EQ(pixel.depth, std::numeric_limits<float>::infinity());
+            EXPECT_EQ(pixel.normal_x, 0.0f);
+            EXPECT_EQ(pixel.alpha, 0.0f);
+        }
+    }
+    EXPECT_GT(background, 0);  // the camera sees past the plane's horizon
 }
 
 TEST(Render, EveryStructureGivesTheSameImages) {
