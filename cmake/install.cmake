@@ -19,6 +19,7 @@ set(CSGRT_KNOWN_DEPENDENCIES
     "TBB::|TBB|tbb"
     "OpenEXR::|OpenEXR 3|OpenEXR"
     "PNG::|PNG|libpng"
+    "libdeflate::|libdeflate|libdeflate"
     "OpenMesh|OpenMesh CONFIG|openmesh")
 
 # csgrt_component_dependencies(<component> <find_out> <public_pc_out> <private_pc_out>)
@@ -138,6 +139,7 @@ configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/csgrtConfig.cmake.in
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/csgrtConfigVersion.cmake
     VERSION ${PROJECT_VERSION} COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/csgrtConfig.cmake ${PROJECT_BINARY_DIR}/csgrtConfigVersion.cmake
+    ${PROJECT_SOURCE_DIR}/cmake/Findlibdeflate.cmake
     DESTINATION ${CSGRT_INSTALL_CMAKEDIR})
 
 # The program, its man page (help2man, from the program's own --help: cmake/man_page.cmake),

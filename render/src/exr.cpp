@@ -1,6 +1,5 @@
 #include "csgrt/render/exr.h"
 
-#include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfDoubleAttribute.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -9,36 +8,27 @@
 #include <OpenEXR/ImfInputPart.h>
 #include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfMultiPartInputFile.h>
-#include <OpenEXR/ImfMultiPartOutputFile.h>
-#include <OpenEXR/ImfOutputPart.h>
-#include <OpenEXR/ImfPartType.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
-#include <OpenEXR/ImfThreading.h>
 #include <OpenEXR/ImfVecAttribute.h>
 #include <tbb/parallel_invoke.h>
 #include <unistd.h>
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
-#include <limits>
 #include <memory>
-#include <new>
 #include <stdexcept>
 #include <string>
-#include <string_view>
 #include <system_error>
-#include <thread>
 #include <vector>
 
 #include "csgrt/csg/scene.h"
 #include "csgrt/render/png.h"
-#include "exr_id_manifest.h"
+#include "exr_channels.h"
+#include "exr_write.h"
 
 namespace csgrt {
 
@@ -81,188 +71,13 @@ private:
     bool committed_ = false;
 };
 
-struct ChannelSpec {
-    const char* name;
-    /// The part it is written to: 0 (kImagePart) or 1 (kIdPart).
-    int part;
-    Imf::PixelType file_type;
-    Imf::PixelType memory_type;
-    std::size_t offset;
-    double fill;
-    /// Read from files of earlier csgrt versions when the file lacks the channel that now
-    /// holds the value; never written.
-    bool legacy = false;
-};
-
-constexpr int kImagePart = 0;
-constexpr int kIdPart = 1;
-const std::array<const char*, 2> kPartNames = {"rgba", "id"};
-
-// The channels in file order, with their part, where each lives in a Pixel and what a missing
-// one reads as; the half channels come first, in the order of the write buffer. The id has a
-// part of its own: OpenImageIO gives a part one pixel type, and in a part of mixed types it
-// converts a uint channel to float normalised by 2^32 - 1, which loses the ids.
-// The cost is the layer "cost" with one channel per count (Nuke's and OpenImageIO's
-// layer.channel rule: the last dot separates them); earlier files had one channel "cost".
-const std::array<ChannelSpec, 14> kChannels = {{
-    {"R", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, red), 0.0},
-    {"G", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, green), 0.0},
-    {"B", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, blue), 0.0},
-    {"A", kImagePart, Imf::HALF, Imf::FLOAT, offsetof(Pixel, alpha), 0.0},
-    {"Z", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, depth), kInfinity},
-    {"N.X", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_x), 0.0},
-    {"N.Y", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_y), 0.0},
-    {"N.Z", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, normal_z), 0.0},
-    {"cost.nodes", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost_nodes), 0.0},
-    {"cost.primitives", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost_primitives), 0.0},
-    {"cost.solves", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost_solves), 0.0},
-    {"cost.total", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost), 0.0},
-    {"cost", kImagePart, Imf::FLOAT, Imf::FLOAT, offsetof(Pixel, cost), 0.0, true},
-    {"id", kIdPart, Imf::UINT, Imf::UINT, offsetof(Pixel, object_id), double(kNoIndex)},
-}};
-
-Imath::V3d to_imath(const Vector3& v) {
-    return Imath::V3d(v.x(), v.y(), v.z());
+/// Every channel is a float in memory but the id, whatever its type in the file.
+Imf::PixelType memory_type(detail::ExrPixelType type) {
+    return type == detail::ExrPixelType::UnsignedInt ? Imf::UINT : Imf::FLOAT;
 }
+
 Vector3 from_imath(const Imath::V3d& v) {
     return Vector3(v.x, v.y, v.z);
-}
-
-/// OpenEXR's world-to-camera matrix: camera at the origin, x right, y up, z along the view
-/// (left-handed, as RenderMan), for row vectors (p' = p M) as Imath stores matrices.
-Imath::M44f world_to_camera(const Camera& camera) {
-    const Vector3 forward = (camera.look_at - camera.position).normalized();
-    const Vector3 right = forward.cross(camera.up).normalized();
-    const Vector3 up = right.cross(forward);
-    const std::array<Vector3, 3> axes = {right, up, forward};
-    Imath::M44f matrix;  // identity
-    for (int j = 0; j < 3; ++j) {
-        for (int i = 0; i < 3; ++i) matrix[i][j] = static_cast<float>(axes[j][i]);
-        matrix[3][j] = static_cast<float>(-axes[j].dot(camera.position));
-    }
-    return matrix;
-}
-
-/// zlib's fastest level. A 2048^2 showcase frame is 185 MB of channels; zipping them took
-/// 2.0 s of CPU at OpenEXR's default level 4 and takes 1.3 s at level 1, for a file 4% larger
-/// (24.4 MB instead of 23.3 MB). The pixels read back are the same at any level.
-constexpr int kZipLevel = 1;
-
-/// The names of a cost layer's channels, in Pixel's order: "cost.<structure>.nodes", ...
-std::array<std::string, 4> cost_layer_channels(const std::string& structure) {
-    const std::string prefix = "cost." + structure + ".";
-    return {prefix + "nodes", prefix + "primitives", prefix + "solves", prefix + "total"};
-}
-
-std::array<const std::vector<float>*, 4> channels_of(const CostLayer& layer) {
-    return {&layer.nodes, &layer.primitives, &layer.solves, &layer.total};
-}
-
-void write_exr_file(const std::filesystem::path& path, const Image& image,
-                    const ExrMetadata& metadata, std::span<const CostLayer> cost_layers) {
-    std::vector<Imf::Header> headers(kPartNames.size(), Imf::Header(image.width(), image.height()));
-    for (std::size_t part = 0; part < headers.size(); ++part) {
-        headers[part].setName(kPartNames[part]);
-        headers[part].setType(Imf::SCANLINEIMAGE);
-        headers[part].compression() = Imf::ZIP_COMPRESSION;
-        headers[part].zipCompressionLevel() = kZipLevel;
-    }
-    for (const ChannelSpec& channel : kChannels) {
-        if (channel.legacy) continue;
-        headers[channel.part].channels().insert(channel.name, Imf::Channel(channel.file_type));
-    }
-    Imf::Header& header = headers[kImagePart];
-    header.insert("resolution", Imf::V2iAttribute(Imath::V2i(image.width(), image.height())));
-    const Camera& camera = metadata.camera;
-    const bool pinhole = camera.projection == Camera::Projection::Pinhole;
-    header.insert("cameraProjection", Imf::StringAttribute(pinhole ? "pinhole" : "orthographic"));
-    header.insert("cameraPosition", Imf::V3dAttribute(to_imath(camera.position)));
-    header.insert("cameraLookAt", Imf::V3dAttribute(to_imath(camera.look_at)));
-    header.insert("cameraUp", Imf::V3dAttribute(to_imath(camera.up)));
-    if (pinhole) {
-        header.insert("cameraVerticalFov", Imf::DoubleAttribute(camera.vertical_fov_degrees));
-    } else {
-        header.insert("cameraOrthographicHeight", Imf::DoubleAttribute(camera.orthographic_height));
-    }
-    Imf::addWorldToCamera(header, world_to_camera(camera));
-    header.insert("accelerator", Imf::StringAttribute(metadata.accelerator));
-    // Timings differ from run to run: only when asked, so identical renders give identical files.
-    if (metadata.include_timing) {
-        header.insert("acceleratorBuildMs",
-                      Imf::DoubleAttribute(metadata.accelerator_build_milliseconds));
-        header.insert("renderSeconds", Imf::DoubleAttribute(metadata.render_seconds));
-    }
-    header.insert("samplesPerPixel", Imf::IntAttribute(metadata.samples_per_pixel));
-    header.insert("scene", Imf::StringAttribute(metadata.scene));
-    // --cost-all: one layer per structure, its build time beside it (a timing, asked for).
-    for (const CostLayer& layer : cost_layers) {
-        if (layer.width != image.width() || layer.height != image.height()) {
-            throw std::runtime_error("cost layer '" + layer.structure + "' is " +
-                                     std::to_string(layer.width) + "x" +
-                                     std::to_string(layer.height) + ", not the image's size");
-        }
-        for (const std::string& name : cost_layer_channels(layer.structure)) {
-            header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-        }
-        header.insert("cost." + layer.structure + ".buildMilliseconds",
-                      Imf::DoubleAttribute(layer.build_milliseconds));
-        header.insert("cost." + layer.structure + ".traceMilliseconds",
-                      Imf::DoubleAttribute(layer.trace_milliseconds));
-    }
-    Imf::addIDManifest(headers[kIdPart], detail::id_manifest(metadata, kZipLevel));
-
-    // OpenEXR converts pixel types when reading but not when writing: the colour channels go
-    // through a half buffer (R, G, B, A interleaved).
-    std::vector<std::array<half, 4>> colour(image.pixel_count());
-    for (std::size_t i = 0; i < colour.size(); ++i) {
-        const Pixel& pixel = image.pixels()[i];
-        colour[i] = {half(pixel.red), half(pixel.green), half(pixel.blue), half(pixel.alpha)};
-    }
-    std::vector<Imf::FrameBuffer> frame_buffers(kPartNames.size());
-    const char* base = reinterpret_cast<const char*>(image.pixels().data());
-    const std::size_t row = sizeof(Pixel) * static_cast<std::size_t>(image.width());
-    const std::size_t colour_row = sizeof(colour[0]) * static_cast<std::size_t>(image.width());
-    for (std::size_t c = 0; c < kChannels.size(); ++c) {
-        const ChannelSpec& channel = kChannels[c];
-        if (channel.legacy) continue;
-        Imf::FrameBuffer& frame_buffer = frame_buffers[channel.part];
-        if (channel.file_type == Imf::HALF) {
-            char* channel_base = reinterpret_cast<char*>(colour.data()) + c * sizeof(half);
-            frame_buffer.insert(channel.name,
-                                Imf::Slice(Imf::HALF, channel_base, sizeof(colour[0]), colour_row));
-        } else {
-            frame_buffer.insert(channel.name, Imf::Slice(channel.file_type,
-                                                         const_cast<char*>(base + channel.offset),
-                                                         sizeof(Pixel), row));
-        }
-    }
-    const std::size_t float_row = sizeof(float) * static_cast<std::size_t>(image.width());
-    for (const CostLayer& layer : cost_layers) {
-        const std::array<std::string, 4> names = cost_layer_channels(layer.structure);
-        const auto channels = channels_of(layer);
-        for (std::size_t c = 0; c < names.size(); ++c) {
-            char* data = reinterpret_cast<char*>(const_cast<float*>(channels[c]->data()));
-            frame_buffers[kImagePart].insert(
-                names[c], Imf::Slice(Imf::FLOAT, data, sizeof(float), float_row));
-        }
-    }
-    // OpenEXR zips its 16-line chunks on its own thread pool when it has one; without, a 2048^2
-    // frame's zlib work runs on one core. The chunks are independent and written in line order,
-    // so the file's bytes do not depend on the thread count. Set once for the process, and only
-    // if the program has not chosen a count itself.
-    static const bool kThreadsChosen = [] {
-        if (Imf::globalThreadCount() == 0) {
-            Imf::setGlobalThreadCount(static_cast<int>(std::thread::hardware_concurrency()));
-        }
-        return true;
-    }();
-    static_cast<void>(kThreadsChosen);
-    Imf::MultiPartOutputFile file(path.c_str(), headers.data(), static_cast<int>(headers.size()));
-    for (std::size_t part = 0; part < headers.size(); ++part) {
-        Imf::OutputPart output(file, static_cast<int>(part));
-        output.setFrameBuffer(frame_buffers[part]);
-        output.writePixels(image.height());
-    }
 }
 
 /// The --cost-all layers of the first part: every channel "cost.<structure>.total" names one.
@@ -291,7 +106,7 @@ void read_cost_layers(Imf::MultiPartInputFile& file, ExrFile& result) {
     }
     const Imath::Box2i window = header.dataWindow();
     for (CostLayer& layer : result.cost_layers) {
-        const std::array<std::string, 4> names = cost_layer_channels(layer.structure);
+        const std::array<std::string, 4> names = detail::cost_layer_channels(layer.structure);
         const std::array<std::vector<float>*, 4> channels = {&layer.nodes, &layer.primitives,
                                                              &layer.solves, &layer.total};
         for (std::size_t c = 0; c < names.size(); ++c) {
@@ -320,7 +135,7 @@ void write_exr(const std::filesystem::path& path, const Image& image, const ExrM
                std::span<const CostLayer> cost_layers) {
     TemporaryFile temporary(path);
     try {
-        write_exr_file(temporary.path(), image, metadata, cost_layers);
+        detail::write_exr_file(temporary.path(), image, metadata, cost_layers);
     } catch (const std::exception& error) {
         throw std::runtime_error("cannot write '" + path.string() + "': " + error.what());
     }
@@ -337,23 +152,23 @@ ExrFile read_exr(const std::filesystem::path& path) {
             Image(window.max.x - window.min.x + 1, window.max.y - window.min.y + 1), {}, {}};
         char* base = reinterpret_cast<char*>(result.image.pixels().data());
         const std::size_t row = sizeof(Pixel) * static_cast<std::size_t>(result.image.width());
-        std::vector<bool> found(kChannels.size(), false);
+        std::vector<bool> found(detail::kExrChannels.size(), false);
         for (int part = 0; part < file.parts(); ++part) {
             if (file.header(part).dataWindow() != window) continue;
             Imf::FrameBuffer frame_buffer;
-            for (std::size_t c = 0; c < kChannels.size(); ++c) {
-                const ChannelSpec& channel = kChannels[c];
+            for (std::size_t c = 0; c < detail::kExrChannels.size(); ++c) {
+                const detail::ExrChannel& channel = detail::kExrChannels[c];
                 if (found[c] || !file.header(part).channels().findChannel(channel.name)) continue;
                 if (channel.legacy &&
-                    std::any_of(kChannels.begin(), kChannels.end(),
-                                [&](const ChannelSpec& current) {
+                    std::any_of(detail::kExrChannels.begin(), detail::kExrChannels.end(),
+                                [&](const detail::ExrChannel& current) {
                                     return !current.legacy && current.offset == channel.offset &&
                                            file.header(part).channels().findChannel(current.name);
                                 }))
                     continue;
                 found[c] = true;
                 frame_buffer.insert(channel.name,
-                                    Imf::Slice::Make(channel.memory_type, base + channel.offset,
+                                    Imf::Slice::Make(memory_type(channel.file_type), base + channel.offset,
                                                      window, sizeof(Pixel), row));
             }
             Imf::InputPart input(file, part);
@@ -468,7 +283,7 @@ void write_render_files(const std::filesystem::path& exr_path, const Image& imag
         // The EXR (zipped on OpenEXR's threads) beside the previews: they share nothing but
         // the image, which all of them only read.
         tbb::parallel_invoke(
-            [&] { write_exr_file(temporaries[0]->path(), image, metadata, cost_layers); },
+            [&] { detail::write_exr_file(temporaries[0]->path(), image, metadata, cost_layers); },
             [&] {
                 write_colour_png(temporaries[1]->path(), image, tone_mapping);
                 write_cost_png(temporaries[2]->path(), image);

@@ -14,13 +14,17 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <Imath/half.h>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <set>
 #include <sstream>
 #include <string>
@@ -334,6 +338,138 @@ TEST(ReadExr, ReportsAFileThatIsNotAnExr) {
     }
     EXPECT_THROW(read_exr(directory / "text.exr"), std::runtime_error);
     EXPECT_THROW(read_exr(directory / "missing.exr"), std::runtime_error);
+}
+
+std::uint32_t bits_of(float value) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &value, sizeof(bits));
+    return bits;
+}
+
+float float_of(std::uint32_t bits) {
+    float value;
+    std::memcpy(&value, &bits, sizeof(value));
+    return value;
+}
+
+/// Every value of every channel from `random` bit patterns (NaNs, infinities and subnormals
+/// among them: nothing a zip chunk could shorten), or one constant pixel (everything can).
+Image chunk_test_image(int width, int height, bool noise, std::mt19937& random) {
+    Image image(width, height);
+    for (Pixel& pixel : image.pixels()) {
+        for (float* channel : {&pixel.red, &pixel.green, &pixel.blue, &pixel.alpha, &pixel.depth,
+                               &pixel.normal_x, &pixel.normal_y, &pixel.normal_z, &pixel.cost,
+                               &pixel.cost_nodes, &pixel.cost_primitives, &pixel.cost_solves}) {
+            *channel = noise ? float_of(random()) : 0.25f;
+        }
+        pixel.object_id = noise ? random() : 7u;
+    }
+    return image;
+}
+
+// The writer compresses EXR's ZIP chunks itself (16 lines each, the last one shorter) and
+// stores a chunk uncompressed when zlib does not shorten it. Every channel reads back with
+// OpenEXR's own reader as the pixel held it: the bits of each float and uint, and the colour
+// as Imath's rounding to half gives it; for every size of last chunk and either kind of chunk.
+TEST(WriteExr, EveryChunkReadsBackAsWrittenWhateverItsSizeOrContent) {
+    const auto directory = fresh_directory("exr_chunks");
+    std::mt19937 random(20261207);
+    struct Size {
+        int width;
+        int height;
+    };
+    for (const Size size : {Size{1, 1}, Size{7, 17}, Size{33, 40}, Size{2, 16}}) {
+        for (const bool noise : {true, false}) {
+            SCOPED_TRACE(std::to_string(size.width) + "x" + std::to_string(size.height) +
+                         (noise ? " noise" : " constant"));
+            const Image image = chunk_test_image(size.width, size.height, noise, random);
+            CostLayer layer;
+            layer.structure = "grid";
+            layer.width = size.width;
+            layer.height = size.height;
+            for (std::vector<float>* values :
+                 {&layer.nodes, &layer.primitives, &layer.solves, &layer.total}) {
+                for (std::size_t i = 0; i < image.pixel_count(); ++i) {
+                    values->push_back(noise ? float_of(random()) : 3.0f);
+                }
+            }
+            const auto path = directory / "chunks.exr";
+            write_exr(path, image, sample_metadata(), std::span<const CostLayer>(&layer, 1));
+            const ExrFile file = read_exr(path);
+            ASSERT_EQ(file.image.pixel_count(), image.pixel_count());
+            for (std::size_t i = 0; i < image.pixel_count(); ++i) {
+                const Pixel& a = image.pixels()[i];
+                const Pixel& b = file.image.pixels()[i];
+                ASSERT_EQ(bits_of(b.red), bits_of(float(half(a.red)))) << i;
+                ASSERT_EQ(bits_of(b.green), bits_of(float(half(a.green)))) << i;
+                ASSERT_EQ(bits_of(b.blue), bits_of(float(half(a.blue)))) << i;
+                ASSERT_EQ(bits_of(b.alpha), bits_of(float(half(a.alpha)))) << i;
+                for (const auto member : {&Pixel::depth, &Pixel::normal_x, &Pixel::normal_y,
+                                          &Pixel::normal_z, &Pixel::cost, &Pixel::cost_nodes,
+                                          &Pixel::cost_primitives, &Pixel::cost_solves}) {
+                    ASSERT_EQ(bits_of(b.*member), bits_of(a.*member)) << i;
+                }
+                ASSERT_EQ(b.object_id, a.object_id) << i;
+            }
+            ASSERT_EQ(file.cost_layers.size(), 1u);
+            EXPECT_EQ(file.cost_layers[0].structure, "grid");
+            const std::vector<float>* written[] = {&layer.nodes, &layer.primitives, &layer.solves,
+                                                   &layer.total};
+            const std::vector<float>* read[] = {&file.cost_layers[0].nodes,
+                                                &file.cost_layers[0].primitives,
+                                                &file.cost_layers[0].solves,
+                                                &file.cost_layers[0].total};
+            for (int c = 0; c < 4; ++c) {
+                ASSERT_EQ(read[c]->size(), written[c]->size());
+                for (std::size_t i = 0; i < written[c]->size(); ++i) {
+                    ASSERT_EQ(bits_of((*read[c])[i]), bits_of((*written[c])[i])) << c << " " << i;
+                }
+            }
+            // Noise is stored (the file holds at least its 54 bytes a pixel: 4 halves, 12
+            // floats, a uint); a constant image zips to a small part of that.
+            const auto bytes = std::filesystem::file_size(path);
+            const auto raw = 54u * image.pixel_count();
+            if (noise) {
+                EXPECT_GE(bytes, raw);
+            } else if (image.pixel_count() >= 64) {
+                EXPECT_LT(bytes, raw / 2);
+            }
+        }
+    }
+}
+
+TEST(WriteExr, TheFileDoesNotDependOnTheThreadCount) {
+    const auto directory = fresh_directory("exr_threads");
+    std::mt19937 random(7);
+    Image image(300, 70);  // 5 chunks a part, the last of 6 lines
+    for (Pixel& pixel : image.pixels()) {
+        pixel.red = float(random() % 1000) / 999.0f;
+        pixel.depth = float(random() % 5000) * 0.01f;
+        pixel.object_id = random() % 3;
+    }
+    {
+        const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        write_exr(directory / "one.exr", image, sample_metadata());
+    }
+    write_exr(directory / "all.exr", image, sample_metadata());
+    EXPECT_EQ(test::file_contents(directory / "one.exr"),
+              test::file_contents(directory / "all.exr"));
+}
+
+// OpenEXR 3.1's reader of the idManifest attribute reads 4 bytes past it, into the name of the
+// attribute after it; the id part must still read whole (its chunkCount found), as before.
+TEST(WriteExr, TheIdPartReadsWholeWithOpenExr31sReader) {
+    const auto directory = fresh_directory("exr_id_part");
+    std::mt19937 random(1);
+    write_exr(directory / "out.exr", chunk_test_image(3, 40, false, random), sample_metadata());
+    Imf::MultiPartInputFile file((directory / "out.exr").c_str());
+    ASSERT_EQ(file.parts(), 2);
+    for (int part = 0; part < 2; ++part) {
+        ASSERT_TRUE(file.header(part).hasChunkCount()) << part;
+        EXPECT_EQ(file.header(part).chunkCount(), 3) << part;  // 40 lines, 16 a chunk
+        EXPECT_EQ(file.header(part).compression(), Imf::ZIP_COMPRESSION) << part;
+    }
+    EXPECT_TRUE(Imf::hasIDManifest(file.header(1)));
 }
 
 }  // namespace
