@@ -1,12 +1,92 @@
 #include "arrays.h"
 #include "queries.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <deque>
+#include <mutex>
+#include <new>
 
 #include "csgrt/core/error.h"
 
 namespace csgrt::python {
+
+namespace {
+
+constexpr std::size_t kHugePage = std::size_t(1) << 21;
+constexpr std::size_t kSmallestKept = std::size_t(1) << 20;
+constexpr std::size_t kMostKept = std::size_t(256) << 20;
+
+/// The kept blocks, oldest first, by their size (a multiple of 2 MiB).
+struct KeptBlocks {
+    std::mutex mutex;
+    std::deque<std::pair<std::size_t, void*>> blocks;
+    std::size_t bytes = 0;
+};
+
+/// Never destroyed: arrays may die during the interpreter's shutdown, after static objects.
+KeptBlocks& kept_blocks() {
+    static KeptBlocks* kept = new KeptBlocks;
+    return *kept;
+}
+
+std::size_t kept_size(std::size_t bytes) {
+    return (bytes + kHugePage - 1) / kHugePage * kHugePage;
+}
+
+}  // namespace
+
+void* result_memory(std::size_t bytes) {
+    if (bytes < kSmallestKept) {
+        void* block = std::malloc(bytes);
+        if (block == nullptr) throw std::bad_alloc();
+        return block;
+    }
+    const std::size_t size = kept_size(bytes);
+    {
+        KeptBlocks& kept = kept_blocks();
+        const std::lock_guard<std::mutex> lock(kept.mutex);
+        // The newest block of the size: the likeliest still in cache.
+        for (auto it = kept.blocks.rbegin(); it != kept.blocks.rend(); ++it) {
+            if (it->first != size) continue;
+            void* block = it->second;
+            kept.bytes -= size;
+            kept.blocks.erase(std::next(it).base());
+            return block;
+        }
+    }
+    void* block = std::aligned_alloc(kHugePage, size);
+    if (block == nullptr) throw std::bad_alloc();
+    // Advice only, as for the renderer's image (render/image.h): fewer, larger page faults.
+    static_cast<void>(::madvise(block, size, MADV_HUGEPAGE));
+    return block;
+}
+
+void release_result_memory(void* block, std::size_t bytes) {
+    if (bytes < kSmallestKept) {
+        std::free(block);
+        return;
+    }
+    const std::size_t size = kept_size(bytes);
+    KeptBlocks& kept = kept_blocks();
+    const std::lock_guard<std::mutex> lock(kept.mutex);
+    kept.blocks.emplace_back(size, block);
+    kept.bytes += size;
+    while (kept.bytes > kMostKept) {
+        std::free(kept.blocks.front().second);
+        kept.bytes -= kept.blocks.front().first;
+        kept.blocks.pop_front();
+    }
+}
+
+std::size_t kept_result_memory() {
+    KeptBlocks& kept = kept_blocks();
+    const std::lock_guard<std::mutex> lock(kept.mutex);
+    return kept.bytes;
+}
 
 std::string shape_text(const py::array& array) {
     std::string text = "(";

@@ -2,6 +2,7 @@
 
 #include <pybind11/pybind11.h>
 
+#include "arrays.h"
 #include "bindings.h"
 #include "csgrt/mesh/mesh_io.h"
 #include "csgrt/core/error.h"
@@ -38,6 +39,8 @@ releases the GIL. See docs/python.md.
             mesh_error(e.what());
         }
     });
+    // Internal, for the tests: the bytes of dead result arrays kept for the next results.
+    m.def("_kept_result_memory", &csgrt::python::kept_result_memory);
     csgrt::python::bind_raycasting_scene(m);
     csgrt::python::bind_scene(m);
 }

@@ -53,13 +53,18 @@ template <class Real, class Target>
 py::dict cast_rays_as(const Target& target, const FloatInput& rays, double tnear, double tfar,
                       const std::unordered_set<std::string>& wanted, const BatchConfig& config) {
     const auto& leading = rays.leading;
-    auto t = output<Real>(leading);
-    auto geometry = output<std::uint32_t>(leading);
-    auto primitive = output<std::uint32_t>(leading);
-    auto uv = output<Real>(leading, {2});
-    auto normal = output<Real>(leading, {3});
-    auto shading = output<Real>(leading, {3});
-    auto material = output<std::uint32_t>(leading);
+    // Only the outputs asked for take memory (the others stay empty, never returned).
+    const auto asked = [&](const char* name, auto type, std::initializer_list<py::ssize_t> tail) {
+        using T = typename decltype(type)::type;
+        return wanted.count(name) ? output<T>(leading, tail) : py::array_t<T>();
+    };
+    auto t = asked("t_hit", std::type_identity<Real>{}, {});
+    auto geometry = asked("geometry_ids", std::type_identity<std::uint32_t>{}, {});
+    auto primitive = asked("primitive_ids", std::type_identity<std::uint32_t>{}, {});
+    auto uv = asked("primitive_uvs", std::type_identity<Real>{}, {2});
+    auto normal = asked("primitive_normals", std::type_identity<Real>{}, {3});
+    auto shading = asked("shading_normals", std::type_identity<Real>{}, {3});
+    auto material = asked(kMaterialOutput, std::type_identity<std::uint32_t>{}, {});
     NearestHitOutputs<Real> outputs;
     if (wanted.count("t_hit")) outputs.t = span_of(t);
     if (wanted.count("geometry_ids")) outputs.object_id = span_of(geometry);

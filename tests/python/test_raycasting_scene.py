@@ -248,3 +248,38 @@ def test_pinhole_rays():
     half_width = np.tan(np.radians(45))
     x_centre = (0.5 * 2 * half_width / 4) - half_width
     np.testing.assert_allclose(rays[0, 0, 3] / -rays[0, 0, 5], x_centre, rtol=1e-6)
+
+
+def test_results_in_reused_memory_hold_nothing_of_the_last_call():
+    # Result arrays of 1 MiB and more reuse the memory of dead ones (python/src/arrays.h), so
+    # a query must write every element: 300,000 rays that all hit a large square, then the
+    # same number that all miss it, each output read against what a miss is.
+    vertices = np.array([[-10, -10, 0], [10, -10, 0], [10, 10, 0], [-10, 10, 0]], np.float32)
+    scene = csgrt.RaycastingScene()
+    scene.add_triangles(vertices, np.array([[0, 1, 2], [0, 2, 3]], np.uint32))
+    count = 300_000
+    rng = np.random.default_rng(5)
+    hitting = np.zeros((count, 6), np.float32)
+    hitting[:, :2] = rng.uniform(-5, 5, (count, 2))
+    hitting[:, 2] = 1
+    hitting[:, 5] = -1
+    missing = hitting.copy()
+    missing[:, 5] = 1  # away from the square
+    first = scene.cast_rays(hitting)
+    assert np.all(first["t_hit"] == 1) and np.all(first["geometry_ids"] == 0)
+    assert np.all(scene.count_intersections(hitting) == 1)
+    del first
+    kept = csgrt._kept_result_memory()
+    assert kept >= 5 * 2**20  # t, ids, uvs and normals of 300,000 rays came back
+    second = scene.cast_rays(missing)
+    assert csgrt._kept_result_memory() < kept  # their memory was taken again
+    np.testing.assert_array_equal(second["t_hit"], np.inf)
+    np.testing.assert_array_equal(second["geometry_ids"], INVALID_ID)
+    np.testing.assert_array_equal(second["primitive_ids"], INVALID_ID)
+    np.testing.assert_array_equal(second["primitive_uvs"], 0)
+    np.testing.assert_array_equal(second["primitive_normals"], 0)
+    np.testing.assert_array_equal(scene.count_intersections(missing), 0)
+    # What is kept stays bounded however many results die at once: 40 x 10 MB here.
+    results = [scene.cast_rays(hitting) for _ in range(40)]
+    del results
+    assert 200 * 2**20 < csgrt._kept_result_memory() <= 256 * 2**20
