@@ -5,9 +5,9 @@
 #include <OpenEXR/ImfIO.h>
 #include <OpenEXR/openexr.h>
 #include <libdeflate.h>
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -417,25 +417,38 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
             chunks.push_back({part, line, std::min(lines_per_chunk, image.height() - line)});
         }
     }
-    // Chunks are independent: encoded on every thread, then written in order, so the file's
-    // bytes do not depend on the thread count.
-    std::vector<std::vector<unsigned char>> encoded(chunks.size());
+    // Chunks are independent: encoded on every thread and written in order as they come, so
+    // the file's bytes do not depend on the thread count, and at most a few chunks a thread
+    // are held (all of a 16384^2 frame's would be as large as its image).
+    struct Encoded {
+        std::size_t index = 0;
+        std::vector<unsigned char> bytes;
+    };
     tbb::enumerable_thread_specific<ChunkScratch> scratch;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks.size(), 1),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                          ChunkScratch& own = scratch.local();
-                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                              const Chunk& chunk = chunks[i];
-                              encoded[i] = encode_chunk(channels[chunk.part], image.width(),
-                                                        chunk.first_line, chunk.lines, own);
-                          }
-                      });
-    for (std::size_t i = 0; i < chunks.size(); ++i) {
-        writer.check(exr_write_scanline_chunk(context, chunks[i].part, chunks[i].first_line,
-                                              encoded[i].data(), encoded[i].size()),
-                     "cannot write the lines from " + std::to_string(chunks[i].first_line));
-        std::vector<unsigned char>().swap(encoded[i]);
-    }
+    std::size_t next = 0;
+    const auto in_flight = static_cast<std::size_t>(4 * tbb::this_task_arena::max_concurrency());
+    tbb::parallel_pipeline(
+        in_flight,
+        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                            [&](tbb::flow_control& control) -> std::size_t {
+                                                if (next == chunks.size()) control.stop();
+                                                return next++;
+                                            }) &
+            tbb::make_filter<std::size_t, Encoded>(
+                tbb::filter_mode::parallel,
+                [&](std::size_t i) {
+                    const Chunk& chunk = chunks[i];
+                    return Encoded{i, encode_chunk(channels[chunk.part], image.width(),
+                                                   chunk.first_line, chunk.lines, scratch.local())};
+                }) &
+            tbb::make_filter<Encoded, void>(
+                tbb::filter_mode::serial_in_order, [&](const Encoded& encoded) {
+                    const Chunk& chunk = chunks[encoded.index];
+                    writer.check(exr_write_scanline_chunk(context, chunk.part, chunk.first_line,
+                                                          encoded.bytes.data(),
+                                                          encoded.bytes.size()),
+                                 "cannot write the lines from " + std::to_string(chunk.first_line));
+                }));
     writer.finish();
 }
 
