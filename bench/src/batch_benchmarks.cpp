@@ -1,5 +1,7 @@
 // trace/<mesh>/bvh-batch/<rays>/threads:<n>: the batch queries of csg/batch.h over the BVH, on
-// the same rays as the single-ray loops (bvh, embree) they are reported beside.
+// the same rays as the single-ray loops (bvh, embree) they are reported beside; and
+// trace/<mesh>/bvh-loop/<rays>/threads:1, the loop a user would write instead, on the batch's
+// own input.
 
 #include <benchmark/benchmark.h>
 
@@ -112,6 +114,58 @@ void register_batch_trace(Workloads& workloads, const std::string& mesh, const s
     // As the single-ray rows: one thread is the thread's CPU time (the batch runs inline on
     // it), several threads wall time.
     if (threads > 1) benchmark->UseRealTime();
+    benchmark->Unit(benchmark::kMillisecond);
+}
+
+void register_user_loop_trace(Workloads& workloads, const std::string& mesh,
+                              const std::string& rays) {
+    const std::string name = "trace/" + mesh + "/bvh-loop/" + rays + "/threads:1";
+    register_info(name, {"trace", mesh, "bvh-loop", rays, 1});
+    auto* benchmark = benchmark::RegisterBenchmark(
+        name.c_str(), [&workloads, mesh, rays](benchmark::State& state) {
+            MeshWorkload& workload = workloads.get(mesh);
+            const auto triangles = static_cast<double>(workload.triangles());
+            const TriangleSet<float>& set = workload.float_set();
+            const Accelerator<TriangleSet<float>>& bvh = batch_bvh(mesh, set);
+            const RayColumns columns(workload.rays(rays).rays);
+            const std::size_t n = columns.t_min.size();
+            std::vector<double> t(n);
+            std::vector<std::uint32_t> primitive(n);
+            std::vector<std::uint8_t> occluded_out(n);
+            QueryScratch scratch;
+            const bool occlusion = rays == "shadow";
+            for (auto _ : state) {
+                const double* row = columns.rays.data();
+                for (std::size_t i = 0; i < n; ++i, row += 6) {
+                    Ray ray;
+                    ray.origin = Point3(row[0], row[1], row[2]);
+                    ray.direction = Vector3(row[3], row[4], row[5]);
+                    ray.t_min = columns.t_min[i];
+                    ray.t_max = columns.t_max[i];
+                    if (occlusion) {
+                        occluded_out[i] = bvh.occluded(ray, scratch) ? 1 : 0;
+                    } else {
+                        HitRecord record;
+                        const bool hit = bvh.intersect(ray, record, scratch);
+                        t[i] = hit ? record.t : kInfinity;
+                        primitive[i] = hit ? record.primitive : kNoIndex;
+                    }
+                }
+                benchmark::DoNotOptimize(occlusion ? static_cast<void*>(occluded_out.data())
+                                                   : static_cast<void*>(t.data()));
+                benchmark::ClobberMemory();
+            }
+            std::size_t hits = 0;
+            for (std::size_t i = 0; i < n; ++i) {
+                hits += occlusion ? occluded_out[i] : (primitive[i] != kNoIndex ? 1 : 0);
+            }
+            const auto count = static_cast<double>(n);
+            state.counters["rays"] =
+                benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
+            state.counters["traced"] = count;
+            state.counters["hit_fraction"] = count > 0.0 ? static_cast<double>(hits) / count : 0.0;
+            state.counters["triangles"] = triangles;
+        });
     benchmark->Unit(benchmark::kMillisecond);
 }
 

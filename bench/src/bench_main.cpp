@@ -189,6 +189,7 @@ void register_all(csgrt::bench::Workloads& workloads, const Settings& settings) 
         }
         for (const std::string& rays : ray_sets) {
             register_batch_trace(workloads, mesh, rays, 1);
+            if (!quick) register_user_loop_trace(workloads, mesh, rays);
             if (all > 1 && !quick) register_batch_trace(workloads, mesh, rays, all);
         }
         if (quick) continue;

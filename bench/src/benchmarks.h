@@ -58,6 +58,11 @@ void register_trace(Workloads& workloads, const Settings& settings, const std::s
 /// the same rays, beside the single-ray loops (bench/src/batch_benchmarks.cpp).
 void register_batch_trace(Workloads& workloads, const std::string& mesh, const std::string& rays,
                           int threads);
+/// trace/<mesh>/bvh-loop/<rays>/threads:1: the loop a user writes without the batch, over the
+/// batch's own input: a Ray built from each row of the same (N, 6) array, the BVH's
+/// Accelerator::intersect (occluded for "shadow"), t and the triangle written to arrays.
+void register_user_loop_trace(Workloads& workloads, const std::string& mesh,
+                              const std::string& rays);
 /// build/<mesh>/<variant>/threads:<n>: the build alone, repeated.
 void register_build(Workloads& workloads, const std::string& mesh, const Variant& variant,
                     int threads);
