@@ -61,6 +61,22 @@ struct RayColumns {
     }
 };
 
+/// The counters of a row: rays per second, the rays, the fraction hit (from the occlusion
+/// flags or the triangles written) and the mesh's size.
+void report_rays(benchmark::State& state, bool occlusion, const std::vector<std::uint8_t>& occluded,
+                 const std::vector<std::uint32_t>& primitive, double triangles) {
+    const std::size_t n = occlusion ? occluded.size() : primitive.size();
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        hits += occlusion ? occluded[i] : (primitive[i] != kNoIndex ? 1 : 0);
+    }
+    const auto count = static_cast<double>(n);
+    state.counters["rays"] = benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["traced"] = count;
+    state.counters["hit_fraction"] = count > 0.0 ? static_cast<double>(hits) / count : 0.0;
+    state.counters["triangles"] = triangles;
+}
+
 }  // namespace
 
 void register_batch_trace(Workloads& workloads, const std::string& mesh, const std::string& rays,
@@ -100,16 +116,7 @@ void register_batch_trace(Workloads& workloads, const std::string& mesh, const s
                 }
                 benchmark::ClobberMemory();
             }
-            std::size_t hits = 0;
-            for (std::size_t i = 0; i < n; ++i) {
-                hits += occlusion ? occluded_out[i] : (primitive[i] != kNoIndex ? 1 : 0);
-            }
-            const auto count = static_cast<double>(n);
-            state.counters["rays"] =
-                benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
-            state.counters["traced"] = count;
-            state.counters["hit_fraction"] = count > 0.0 ? static_cast<double>(hits) / count : 0.0;
-            state.counters["triangles"] = triangles;
+            report_rays(state, occlusion, occluded_out, primitive, triangles);
         });
     // As the single-ray rows: one thread is the thread's CPU time (the batch runs inline on
     // it), several threads wall time.
@@ -155,16 +162,7 @@ void register_user_loop_trace(Workloads& workloads, const std::string& mesh,
                                                    : static_cast<void*>(t.data()));
                 benchmark::ClobberMemory();
             }
-            std::size_t hits = 0;
-            for (std::size_t i = 0; i < n; ++i) {
-                hits += occlusion ? occluded_out[i] : (primitive[i] != kNoIndex ? 1 : 0);
-            }
-            const auto count = static_cast<double>(n);
-            state.counters["rays"] =
-                benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
-            state.counters["traced"] = count;
-            state.counters["hit_fraction"] = count > 0.0 ? static_cast<double>(hits) / count : 0.0;
-            state.counters["triangles"] = triangles;
+            report_rays(state, occlusion, occluded_out, primitive, triangles);
         });
     benchmark->Unit(benchmark::kMillisecond);
 }

@@ -1,8 +1,6 @@
 #include "arrays.h"
 #include "queries.h"
 
-#include <sys/mman.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -11,12 +9,12 @@
 #include <new>
 
 #include "csgrt/core/error.h"
+#include "csgrt/core/huge_pages.h"
 
 namespace csgrt::python {
 
 namespace {
 
-constexpr std::size_t kHugePage = std::size_t(1) << 21;
 constexpr std::size_t kSmallestKept = std::size_t(1) << 20;
 constexpr std::size_t kMostKept = std::size_t(256) << 20;
 
@@ -33,10 +31,6 @@ KeptBlocks& kept_blocks() {
     return *kept;
 }
 
-std::size_t kept_size(std::size_t bytes) {
-    return (bytes + kHugePage - 1) / kHugePage * kHugePage;
-}
-
 }  // namespace
 
 void* result_memory(std::size_t bytes) {
@@ -45,7 +39,7 @@ void* result_memory(std::size_t bytes) {
         if (block == nullptr) throw std::bad_alloc();
         return block;
     }
-    const std::size_t size = kept_size(bytes);
+    const std::size_t size = huge_page_block_size(bytes);
     {
         KeptBlocks& kept = kept_blocks();
         const std::lock_guard<std::mutex> lock(kept.mutex);
@@ -58,11 +52,7 @@ void* result_memory(std::size_t bytes) {
             return block;
         }
     }
-    void* block = std::aligned_alloc(kHugePage, size);
-    if (block == nullptr) throw std::bad_alloc();
-    // Advice only, as for the renderer's image (render/image.h): fewer, larger page faults.
-    static_cast<void>(::madvise(block, size, MADV_HUGEPAGE));
-    return block;
+    return allocate_huge_page_block(size);
 }
 
 void release_result_memory(void* block, std::size_t bytes) {
@@ -70,13 +60,13 @@ void release_result_memory(void* block, std::size_t bytes) {
         std::free(block);
         return;
     }
-    const std::size_t size = kept_size(bytes);
+    const std::size_t size = huge_page_block_size(bytes);
     KeptBlocks& kept = kept_blocks();
     const std::lock_guard<std::mutex> lock(kept.mutex);
     kept.blocks.emplace_back(size, block);
     kept.bytes += size;
     while (kept.bytes > kMostKept) {
-        std::free(kept.blocks.front().second);
+        free_huge_page_block(kept.blocks.front().second);
         kept.bytes -= kept.blocks.front().first;
         kept.blocks.pop_front();
     }

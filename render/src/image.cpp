@@ -1,36 +1,22 @@
 #include "csgrt/render/image.h"
 
-#include <sys/mman.h>
-
-#include <cstdlib>
 #include <new>
 
 #include "csgrt/core/error.h"
+#include "csgrt/core/huge_pages.h"
 
 namespace csgrt {
 
-namespace {
-
-constexpr std::size_t kHugePage = std::size_t(1) << 21;
-
-}  // namespace
-
 void* allocate_pixel_memory(std::size_t bytes) {
-    if (bytes < kHugePage) return ::operator new(bytes);
-    // aligned_alloc wants a multiple of the alignment.
-    const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
-    void* pointer = std::aligned_alloc(kHugePage, rounded);
-    if (pointer == nullptr) throw std::bad_alloc();
-    // Advice only: where huge pages are off or unavailable this fails and 4 KiB pages serve.
-    static_cast<void>(::madvise(pointer, rounded, MADV_HUGEPAGE));
-    return pointer;
+    if (bytes < kHugePageBytes) return ::operator new(bytes);
+    return allocate_huge_page_block(bytes);
 }
 
 void free_pixel_memory(void* pointer, std::size_t bytes) {
-    if (bytes < kHugePage) {
+    if (bytes < kHugePageBytes) {
         ::operator delete(pointer);
     } else {
-        std::free(pointer);
+        free_huge_page_block(pointer);
     }
 }
 
