@@ -280,7 +280,7 @@ void write_render_files(const std::filesystem::path& exr_path, const Image& imag
     for (const auto& target : targets)
         temporaries.push_back(std::make_unique<TemporaryFile>(target));
     try {
-        // The EXR (zipped on OpenEXR's threads) beside the previews: they share nothing but
+        // The EXR (its chunks zipped on every thread) beside the previews: they share nothing but
         // the image, which all of them only read.
         tbb::parallel_invoke(
             [&] { detail::write_exr_file(temporaries[0]->path(), image, metadata, cost_layers); },
