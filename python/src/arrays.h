@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -63,17 +64,17 @@ py::array_t<T> output(const std::vector<py::ssize_t>& leading,
     std::size_t count = 1;
     for (const py::ssize_t extent : shape) count *= static_cast<std::size_t>(extent);
     const std::size_t bytes = std::max<std::size_t>(count * sizeof(T), 1);
+    // The array's base owns the block: it goes back when the array and its views die.
     struct Block {
         void* data;
         std::size_t bytes;
+        ~Block() { release_result_memory(data, bytes); }
     };
-    auto* block = new Block{result_memory(bytes), bytes};
-    py::capsule owner(block, [](void* pointer) {
-        auto* owned = static_cast<Block*>(pointer);
-        release_result_memory(owned->data, owned->bytes);
-        delete owned;
-    });
-    return py::array_t<T>(shape, static_cast<T*>(block->data), owner);
+    std::unique_ptr<Block> block(new Block{result_memory(bytes), bytes});  // no temporary Block
+    T* data = static_cast<T*>(block->data);
+    py::capsule owner(block.get(), [](void* pointer) { delete static_cast<Block*>(pointer); });
+    block.release();
+    return py::array_t<T>(shape, data, owner);
 }
 
 template <class T>
