@@ -71,7 +71,8 @@ void report_rays(benchmark::State& state, bool occlusion, const std::vector<std:
         hits += occlusion ? occluded[i] : (primitive[i] != kNoIndex ? 1 : 0);
     }
     const auto count = static_cast<double>(n);
-    state.counters["rays"] = benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["rays"] =
+        benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
     state.counters["traced"] = count;
     state.counters["hit_fraction"] = count > 0.0 ? static_cast<double>(hits) / count : 0.0;
     state.counters["triangles"] = triangles;

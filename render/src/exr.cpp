@@ -167,9 +167,9 @@ ExrFile read_exr(const std::filesystem::path& path) {
                                 }))
                     continue;
                 found[c] = true;
-                frame_buffer.insert(channel.name,
-                                    Imf::Slice::Make(memory_type(channel.file_type), base + channel.offset,
-                                                     window, sizeof(Pixel), row));
+                frame_buffer.insert(channel.name, Imf::Slice::Make(memory_type(channel.file_type),
+                                                                   base + channel.offset, window,
+                                                                   sizeof(Pixel), row));
             }
             Imf::InputPart input(file, part);
             input.setFrameBuffer(frame_buffer);

@@ -62,15 +62,20 @@ std::size_t bytes_per_value(ExrPixelType type) {
 
 exr_pixel_type_t core_type(ExrPixelType type) {
     switch (type) {
-        case ExrPixelType::UnsignedInt: return EXR_PIXEL_UINT;
-        case ExrPixelType::Half: return EXR_PIXEL_HALF;
-        case ExrPixelType::Float: return EXR_PIXEL_FLOAT;
+        case ExrPixelType::UnsignedInt:
+            return EXR_PIXEL_UINT;
+        case ExrPixelType::Half:
+            return EXR_PIXEL_HALF;
+        case ExrPixelType::Float:
+            return EXR_PIXEL_FLOAT;
     }
     return EXR_PIXEL_FLOAT;
 }
 
 struct CompressorDeleter {
-    void operator()(libdeflate_compressor* compressor) const { libdeflate_free_compressor(compressor); }
+    void operator()(libdeflate_compressor* compressor) const {
+        libdeflate_free_compressor(compressor);
+    }
 };
 
 /// One thread's buffers for encoding chunks: reused from chunk to chunk.
@@ -118,8 +123,8 @@ std::vector<unsigned char> encode_chunk(std::span<const ChannelSource> channels,
                 for (int x = 0; x < width; ++x, value += channel.stride) {
                     std::uint32_t bits;
                     std::memcpy(&bits, value, sizeof(bits));
-                    const auto low = static_cast<std::uint16_t>((bits & 0xffu) |
-                                                                ((bits >> 8) & 0xff00u));
+                    const auto low =
+                        static_cast<std::uint16_t>((bits & 0xffu) | ((bits >> 8) & 0xff00u));
                     const auto high = static_cast<std::uint16_t>(((bits >> 8) & 0xffu) |
                                                                  ((bits >> 16) & 0xff00u));
                     std::memcpy(even, &low, sizeof(low));
@@ -276,10 +281,10 @@ void write_header(CoreWriter& writer, const Image& image, const ExrMetadata& met
         writer.check(exr_add_part(context, name.c_str(), EXR_STORAGE_SCANLINE, &index),
                      "cannot add the part '" + name + "'");
         for (const ChannelSource& channel : channels[part]) {
-            writer.check(exr_add_channel(context, index, channel.name.c_str(),
-                                         core_type(channel.type), EXR_PERCEPTUALLY_LOGARITHMIC,
-                                         1, 1),
-                         "cannot add the channel '" + channel.name + "'");
+            writer.check(
+                exr_add_channel(context, index, channel.name.c_str(), core_type(channel.type),
+                                EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1),
+                "cannot add the channel '" + channel.name + "'");
         }
         // The required attributes one by one, in the order OpenEXR's C++ library wrote them
         // (by name), for the idManifest's sake: OpenEXR 3.1's reader of that attribute reads
@@ -292,10 +297,10 @@ void write_header(CoreWriter& writer, const Image& image, const ExrMetadata& met
         writer.check(exr_set_data_window(context, index, &window), what);
         writer.check(exr_set_display_window(context, index, &window), what);
         if (int(part) == kExrIdPart) {
-            writer.check(exr_attr_set_user(context, index, "idManifest", "idmanifest",
-                                           static_cast<std::int32_t>(manifest.size()),
-                                           manifest.data()),
-                         "cannot set the attribute 'idManifest'");
+            writer.check(
+                exr_attr_set_user(context, index, "idManifest", "idmanifest",
+                                  static_cast<std::int32_t>(manifest.size()), manifest.data()),
+                "cannot set the attribute 'idManifest'");
         }
         writer.check(exr_set_lineorder(context, index, EXR_LINEORDER_INCREASING_Y), what);
         writer.check(exr_set_pixel_aspect_ratio(context, index, 1.0f), what);
@@ -389,9 +394,8 @@ std::array<std::vector<ChannelSource>, 2> channel_sources(const Image& image,
     }
     // EXR's channel lists are sorted by name, bytewise (strcmp), and so is each line's data.
     for (auto& part : parts) {
-        std::sort(part.begin(), part.end(), [](const ChannelSource& a, const ChannelSource& b) {
-            return a.name < b.name;
-        });
+        std::sort(part.begin(), part.end(),
+                  [](const ChannelSource& a, const ChannelSource& b) { return a.name < b.name; });
     }
     return parts;
 }
@@ -447,10 +451,10 @@ void write_exr_file(const std::filesystem::path& path, const Image& image,
             tbb::make_filter<Encoded, void>(
                 tbb::filter_mode::serial_in_order, [&](const Encoded& encoded) {
                     const Chunk& chunk = chunks[encoded.index];
-                    writer.check(exr_write_scanline_chunk(context, chunk.part, chunk.first_line,
-                                                          encoded.bytes.data(),
-                                                          encoded.bytes.size()),
-                                 "cannot write the lines from " + std::to_string(chunk.first_line));
+                    writer.check(
+                        exr_write_scanline_chunk(context, chunk.part, chunk.first_line,
+                                                 encoded.bytes.data(), encoded.bytes.size()),
+                        "cannot write the lines from " + std::to_string(chunk.first_line));
                 }));
     writer.finish();
 }

@@ -415,10 +415,9 @@ TEST(WriteExr, EveryChunkReadsBackAsWrittenWhateverItsSizeOrContent) {
             EXPECT_EQ(file.cost_layers[0].structure, "grid");
             const std::vector<float>* written[] = {&layer.nodes, &layer.primitives, &layer.solves,
                                                    &layer.total};
-            const std::vector<float>* read[] = {&file.cost_layers[0].nodes,
-                                                &file.cost_layers[0].primitives,
-                                                &file.cost_layers[0].solves,
-                                                &file.cost_layers[0].total};
+            const std::vector<float>* read[] = {
+                &file.cost_layers[0].nodes, &file.cost_layers[0].primitives,
+                &file.cost_layers[0].solves, &file.cost_layers[0].total};
             for (int c = 0; c < 4; ++c) {
                 ASSERT_EQ(read[c]->size(), written[c]->size());
                 for (std::size_t i = 0; i < written[c]->size(); ++i) {
