@@ -437,6 +437,45 @@ TEST(WriteExr, EveryChunkReadsBackAsWrittenWhateverItsSizeOrContent) {
     }
 }
 
+// The colour channels are rounded to half as Imath's conversion rounds them, bit for bit, at
+// every boundary of the format and for NaNs of every kind (a converter that quiets NaNs, as
+// F16C's does, fails here).
+TEST(WriteExr, ColourRoundsToHalfAsImathDoesAtEveryBoundary) {
+    const std::vector<std::uint32_t> patterns = {
+        0x00000000u, 0x80000000u,              // zeros
+        0x477fe000u, 0x477fefffu, 0x477ff000u,  // 65504, just below and at the overflow tie
+        0x501502f9u, 0x7f800000u, 0xff800000u,  // 1e10, infinities
+        0x38800000u, 0x33800000u, 0x33000000u,  // smallest normal and subnormal half, the tie
+        0x33400000u, 0x33c00000u, 0x387fc000u,  // 1.5 and 3 x 2^-25, largest subnormal
+        0x3f801000u, 0x3f800800u, 0x3f801800u,  // 1 + 2^-10 exact, ties to even down and up
+        0x000116c2u, 0x807fffffu,              // float subnormals
+        0x7f800001u, 0x7fc00000u, 0x7fa00000u,  // signalling, quiet, payload-only NaNs
+        0xffc00001u, 0x7f802000u, 0x7f801fffu,  // negative NaN, payloads at bit 13 and below
+    };
+    const int width = static_cast<int>(patterns.size());  // 25: three groups of 8 and a tail
+    Image image(width, 2);
+    for (int x = 0; x < width; ++x) {
+        for (int y = 0; y < 2; ++y) {
+            Pixel& pixel = image.at(x, y);
+            pixel.red = float_of(patterns[x]);
+            pixel.green = float_of(patterns[(x + y + 1) % width]);
+            pixel.blue = -float_of(patterns[(x + 7) % width]);
+            pixel.alpha = float_of(patterns[(3 * x + y) % width]);
+        }
+    }
+    const auto directory = fresh_directory("exr_half_boundaries");
+    write_exr(directory / "half.exr", image, sample_metadata());
+    const ExrFile file = read_exr(directory / "half.exr");
+    for (std::size_t i = 0; i < image.pixel_count(); ++i) {
+        const Pixel& a = image.pixels()[i];
+        const Pixel& b = file.image.pixels()[i];
+        ASSERT_EQ(half(b.red).bits(), half(a.red).bits()) << i;
+        ASSERT_EQ(half(b.green).bits(), half(a.green).bits()) << i;
+        ASSERT_EQ(half(b.blue).bits(), half(a.blue).bits()) << i;
+        ASSERT_EQ(half(b.alpha).bits(), half(a.alpha).bits()) << i;
+    }
+}
+
 TEST(WriteExr, TheFileDoesNotDependOnTheThreadCount) {
     const auto directory = fresh_directory("exr_threads");
     std::mt19937 random(7);
