@@ -27,8 +27,8 @@
 /// than bsf with a zero test), which build() checks the CPU for with the others.
 #define CSGRT_BVH_AVX2_TARGET "avx2,fma,bmi,bmi2,popcnt"
 /// There is no second compilation of the AVX2 code with AVX-512 allowed: it was made until
-/// 2026-12-07 and measured no faster (docs/benchmarks.md, "AVX-512 compilation"), while it doubled the
-/// compile time of the two sources that hold the queries.
+/// 2026-12-07 and measured no faster (docs/benchmarks.md, "AVX-512 compilation"), while it doubled
+/// the compile time of the two sources that hold the queries.
 #include <immintrin.h>
 #else
 #define CSGRT_BVH_AVX2 0
@@ -369,9 +369,8 @@ struct alignas(32) Avx2FusedNodeTest {
         const double* ray_d = ray.direction.data();
         const __m256d origin4 = _mm256_insertf128_pd(
             _mm256_castpd128_pd256(load_two(ray_o, ray_o + 1)), _mm_load_sd(ray_o + 2), 1);
-        const __m256d direction4 =
-            _mm256_insertf128_pd(_mm256_castpd128_pd256(load_two(ray_d, ray_d + 1)),
-                                 load_two(ray_d + 2, &ray.t_min), 1);
+        const __m256d direction4 = _mm256_insertf128_pd(
+            _mm256_castpd128_pd256(load_two(ray_d, ray_d + 1)), load_two(ray_d + 2, &ray.t_min), 1);
         // Lane 3: origin 0, and t_min rounded to nearest in place of a direction component.
         const __m128 origin = _mm256_cvtpd_ps(origin4);
         const __m128 direction = _mm256_cvtpd_ps(direction4);

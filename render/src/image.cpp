@@ -3,21 +3,15 @@
 #include <new>
 
 #include "csgrt/core/error.h"
-#include "csgrt/core/huge_pages.h"
 
 namespace csgrt {
 
 void* allocate_pixel_memory(std::size_t bytes) {
-    if (bytes < kHugePageBytes) return ::operator new(bytes);
-    return allocate_huge_page_block(bytes);
+    return ::operator new(bytes);
 }
 
-void free_pixel_memory(void* pointer, std::size_t bytes) {
-    if (bytes < kHugePageBytes) {
-        ::operator delete(pointer);
-    } else {
-        free_huge_page_block(pointer);
-    }
+void free_pixel_memory(void* pointer, std::size_t /*bytes*/) {
+    ::operator delete(pointer);
 }
 
 Image::Image(int width, int height) : Image(width, height, true) {}
