@@ -176,7 +176,10 @@ struct BoxRay {
         const float far_scale = signed_interval ? 1.0f : 1.0f + kSlack;
 #if defined(__SSE2__)
         // Lane 3 is padding: origin 0, direction 1.
-        const __m128 origin4 = _mm_movelh_ps(_mm_cvtpd_ps(v0), _mm_cvtpd_ps(_mm_move_sd(zero, v1)));
+        // (o2, 0) as o2's float beside a zero float rather than (o2, 0.0) converted: GCC makes
+        // the latter a vmovq between registers, which Debian 12's valgrind cannot decode.
+        const __m128 origin4 =
+            _mm_movelh_ps(_mm_cvtpd_ps(v0), _mm_move_ss(_mm_setzero_ps(), _mm_cvtpd_ps(v1)));
         const __m128 direction4 =
             _mm_movelh_ps(_mm_cvtpd_ps(_mm_shuffle_pd(v1, v2, 1)),
                           _mm_cvtpd_ps(_mm_unpackhi_pd(v2, _mm_set1_pd(1.0))));
