@@ -1,18 +1,8 @@
 #include "csgrt/render/image.h"
 
-#include <new>
-
 #include "csgrt/core/error.h"
 
 namespace csgrt {
-
-void* allocate_pixel_memory(std::size_t bytes) {
-    return ::operator new(bytes);
-}
-
-void free_pixel_memory(void* pointer, std::size_t /*bytes*/) {
-    ::operator delete(pointer);
-}
 
 Image::Image(int width, int height) : Image(width, height, true) {}
 

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <new>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -38,15 +39,6 @@ struct Pixel {
     float cost_solves = 0.0f;
 };
 
-/// The memory of an image's pixels: operator new's, in pages of 4 KiB. Transparent huge pages
-/// (asked for here from 2026-12-02 to 2026-12-07) fault a 2048^2 image (218 MB) in about 100
-/// pieces rather than 53,000, but on this project's machines (Firecracker guests that report
-/// free 8 MiB blocks to the host, which takes them back) a fresh huge page costs the host's
-/// refault of all of it: an empty 2048^2 frame on one thread took 0.44-0.67 s with them and
-/// 0.17-0.19 s without (docs/benchmarks.md, "The image's pages").
-void* allocate_pixel_memory(std::size_t bytes);
-void free_pixel_memory(void* pointer, std::size_t bytes);
-
 /// With `fill_defaults` false, a new element is left as the memory holds it (Pixel is an
 /// aggregate, so its object exists there: C++20's implicit-lifetime rule) for an owner that
 /// writes every element before it reads one; copies are made as always.
@@ -60,12 +52,14 @@ struct PixelAllocator {
     template <class U>
     PixelAllocator(const PixelAllocator<U>& other) : fill_defaults(other.fill_defaults) {}
 
-    T* allocate(std::size_t count) {
-        return static_cast<T*>(allocate_pixel_memory(count * sizeof(T)));
-    }
-    void deallocate(T* pointer, std::size_t count) {
-        free_pixel_memory(pointer, count * sizeof(T));
-    }
+    // operator new's memory, in pages of 4 KiB. Transparent huge pages (asked for here from
+    // 2026-12-02 to 2026-12-07) fault a 2048^2 image (218 MB) in about 100 pieces rather than
+    // 53,000, but on this project's machines (Firecracker guests that report free 8 MiB blocks
+    // to the host, which takes them back) a fresh huge page costs the host's refault of all of
+    // it: an empty 2048^2 frame on one thread took 0.44-0.67 s with them and 0.17-0.19 s
+    // without (docs/benchmarks.md, "The image's pages").
+    T* allocate(std::size_t count) { return static_cast<T*>(::operator new(count * sizeof(T))); }
+    void deallocate(T* pointer, std::size_t) { ::operator delete(pointer); }
 
     template <class U, class... Args>
     void construct(U* pointer, Args&&... args) {
