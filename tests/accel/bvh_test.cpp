@@ -270,6 +270,25 @@ TYPED_TEST(BvhMeshTest, PacketsGiveTheSingleRayAnswersBitForBit) {
                              ? Aabb(Point3(-0.2, -0.2, -0.2), Point3(0.2, 0.2, 0.2))
                              : test::mesh_bounds(c.mesh);
         std::vector<Ray> rays = camera_grid(box, 45);
+        if (c.name == "integer_cube(8)") {
+            // One origin's rays exactly through the face z = 0's vertices, the midpoints of its
+            // edges and of its quads' diagonals: d_z = 8 makes the shear exact, so the sheared
+            // target is (0, 0) and an edge function of every triangle around it is exactly
+            // zero (the case hit_sheared redoes in double). All directions positive, one test
+            // axis: the packets take the ray-parallel leaf test.
+            for (int j = 1; j <= 8; ++j) {
+                for (int i = 1; i <= 8; ++i) {
+                    for (const Vector3& offset : {Vector3(0.0, 0.0, 0.0), Vector3(0.5, 0.0, 0.0),
+                                                 Vector3(0.5, 0.5, 0.0)}) {
+                        Ray ray;
+                        ray.origin = Point3(0.5, 0.5, -8.0);
+                        ray.direction = Point3(i, j, 0.0) + offset - ray.origin;
+                        if (ray.direction.x() < 8.0 && ray.direction.y() < 8.0)
+                            rays.push_back(ray);
+                    }
+                }
+            }
+        }
         const std::vector<Ray> mixed = mixed_rays(box, test::scaled(3001), 77);
         rays.insert(rays.end(), mixed.begin(), mixed.end());
         for (std::size_t i = 5; i < rays.size(); i += 97) {
