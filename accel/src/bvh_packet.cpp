@@ -29,15 +29,15 @@ struct BvhTraversal<Set>::Packets {
     static constexpr bool kAvx2Test = false;
 #endif
 
-    /// The rays of a packet: each one's box ray and float upper bound, and, made when first
-    /// needed, its node test (the ray-by-ray walk only) and its leaf ray (at its first leaf:
-    /// most camera rays reach none).
+    /// The rays of a packet: each one's float upper bound and (but for packets that
+    /// PacketIntervalTest::accepts_rays takes) its box ray, and, made when first needed, its
+    /// node test (the ray-by-ray walk only) and its leaf ray (at its first leaf: most camera
+    /// rays reach none).
     template <class NodeTest>
     struct PacketLanes {
         using LeafRayType = LeafRayOf<kAvx2Test<NodeTest>>;
         struct Lane {
             BoxRay box;
-            float t_max;
         };
         static_assert(std::is_trivially_destructible_v<Lane> &&
                       std::is_trivially_destructible_v<NodeTest> &&
@@ -46,13 +46,15 @@ struct BvhTraversal<Set>::Packets {
         alignas(NodeTest) unsigned char test_storage[sizeof(NodeTest) * Tree::kPacketRays];
         alignas(LeafRayType) unsigned char leaf_storage[sizeof(LeafRayType) * Tree::kPacketRays];
         std::uint32_t leaf_made = 0;
+        float t_max[Tree::kPacketRays];
 
         Lane& operator[](int r) { return reinterpret_cast<Lane*>(lane_storage)[r]; }
         const Lane& operator[](int r) const {
             return reinterpret_cast<const Lane*>(lane_storage)[r];
         }
         void make(int r, const Ray& ray) {
-            new (&(*this)[r]) Lane{BoxRay(ray), round_up(ray.t_max)};
+            new (&(*this)[r]) Lane{BoxRay(ray)};
+            t_max[r] = round_up(ray.t_max);
         }
         NodeTest& test(int r) { return reinterpret_cast<NodeTest*>(test_storage)[r]; }
         void make_test(int r) { new (&test(r)) NodeTest((*this)[r].box); }
@@ -92,7 +94,7 @@ struct BvhTraversal<Set>::Packets {
                 }
             } else {
                 found[r] |= nearest_in_leaf<false>(bvh, leaf_ray, first, count, best[r],
-                                                   lanes[r].t_max, unused);
+                                                   lanes.t_max[r], unused);
             }
         }
     }
@@ -116,6 +118,23 @@ struct BvhTraversal<Set>::Packets {
         if (nodes.empty()) return;
         PacketLanes<NodeTest> lanes;
         std::uint32_t open = 0;
+#if CSGRT_BVH_AVX2
+        if constexpr (kAvx2Test<NodeTest>) {
+            // The common camera packet (every ray valid, one origin), set up for all its rays
+            // at once; others below, ray by ray.
+            PacketIntervalTest interval;
+            if (interval.accepts_rays(rays.data(), n)) {
+                for (int r = 0; r < n; ++r) {
+                    lanes.t_max[r] = round_up(rays[r].t_max);
+                    best[r] = HitRecord{};
+                    best[r].t = rays[r].t_max;
+                }
+                open = (1u << n) - 1u;
+                return walk_interval_packet<kAny>(bvh, rays, lanes, open, interval, best, found,
+                                                  scratch);
+            }
+        }
+#endif
         for (int r = 0; r < n; ++r) {
             lanes.make(r, rays[r]);
             if (!lanes[r].box.valid) continue;
@@ -160,12 +179,12 @@ struct BvhTraversal<Set>::Packets {
                 unsigned entered = 0;
                 for (std::uint32_t m = active; m != 0; m &= m - 1) {
                     const int r = std::countr_zero(m);
-                    const auto& lane = lanes[r];
                     const NodeTest& test = lanes.test(r);
+                    const float t_max = lanes.t_max[r];
                     alignas(32) float t_enter[kWidth];
-                    const unsigned mask = lane.box.signed_interval
-                                              ? test.template hit<true>(node, lane.t_max, t_enter)
-                                              : test.template hit<false>(node, lane.t_max, t_enter);
+                    const unsigned mask = lanes[r].box.signed_interval
+                                              ? test.template hit<true>(node, t_max, t_enter)
+                                              : test.template hit<false>(node, t_max, t_enter);
                     for (unsigned c = mask; c != 0; c &= c - 1) {
                         const int slot = std::countr_zero(c);
                         child_enter[slot] = std::min(child_enter[slot], t_enter[slot]);
@@ -200,7 +219,7 @@ struct BvhTraversal<Set>::Packets {
                 active = top->rays & open;
                 for (std::uint32_t m = active; m != 0; m &= m - 1) {
                     const int r = std::countr_zero(m);
-                    if (top->t_enter > lanes[r].t_max) active &= ~(1u << r);
+                    if (top->t_enter > lanes.t_max[r]) active &= ~(1u << r);
                 }
             } while (active == 0);
             first = top->first;
@@ -232,7 +251,7 @@ struct BvhTraversal<Set>::Packets {
         auto largest_t_max = [&] {
             float t_max = -kFloatInfinity;
             for (std::uint32_t m = open; m != 0; m &= m - 1)
-                t_max = std::max(t_max, lanes[std::countr_zero(m)].t_max);
+                t_max = std::max(t_max, lanes.t_max[std::countr_zero(m)]);
             return t_max;
         };
         if constexpr (kBlockSet) {
@@ -275,7 +294,7 @@ struct BvhTraversal<Set>::Packets {
                                            std::bit_cast<std::uint32_t>(group[9 * kWidth + lane]),
                                            t, b1, b2, prepared[r], best[r])) {
                                 found[r] = true;
-                                lanes[r].t_max = round_up(best[r].t);
+                                lanes.t_max[r] = round_up(best[r].t);
                             }
                         }
                     };

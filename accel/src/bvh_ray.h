@@ -513,19 +513,120 @@ struct alignas(32) PacketIntervalTest {
                 f_high[axis] = std::max(f_high[axis], ray.inverse_far[axis]);
             }
         }
+        set(o_low, o_high, n_low, n_high, f_low, f_high, first.negative, lowest_t_min);
+        return true;
+    }
+
+    /// accepts for rays[0, n) (1 <= n <= 8) all open, in the common case only: every ray
+    /// representable and valid (as BoxRay finds them), t_min a float >= 0, no zero direction
+    /// component, one origin, one sign per axis, finite reciprocals. The rays' BoxRay values
+    /// are made eight at a time with BoxRay's own float operations lane by lane (cvtpd2ps,
+    /// divps, mulps), so the test is the very one accepts would make from the rays' BoxRays.
+    /// False, with nothing set, for any other packet: accepts then decides from BoxRays.
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] bool accepts_rays(const Ray* rays, int n) {
+        // Ray r's origin, direction, t_min and t_max in column r; columns past n repeat ray 0,
+        // which changes no minimum, maximum or test below.
+        alignas(32) double columns[8][8];
+        for (int r = 0; r < 8; ++r) {
+            const Ray& ray = rays[r < n ? r : 0];
+            for (int k = 0; k < 3; ++k) {
+                columns[k][r] = ray.origin[k];
+                columns[3 + k][r] = ray.direction[k];
+            }
+            columns[6][r] = ray.t_min;
+            columns[7][r] = ray.t_max;
+        }
+        const __m256d sign = _mm256_set1_pd(-0.0);
+        const __m256d largest = _mm256_set1_pd(kLargestBoxRayValue);
+        const __m256d smallest = _mm256_set1_pd(1.0 / kLargestBoxRayValue);
+        __m128 t_min_half[2];
+        unsigned common = 0xffu;
+        int signs[3] = {0, 0, 0};
+        for (int half = 0; half < 2; ++half) {
+            __m256d ok = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+            for (int axis = 0; axis < 3; ++axis) {
+                const __m256d o = _mm256_load_pd(columns[axis] + 4 * half);
+                const __m256d d = _mm256_load_pd(columns[3 + axis] + 4 * half);
+                const __m256d magnitude = _mm256_andnot_pd(sign, d);
+                // BoxRay's representability without its zero case (false for NaN), and one
+                // origin, compared in double.
+                ok = _mm256_and_pd(ok, _mm256_cmp_pd(_mm256_andnot_pd(sign, o), largest,
+                                                     _CMP_LE_OQ));
+                ok = _mm256_and_pd(ok, _mm256_cmp_pd(magnitude, largest, _CMP_LE_OQ));
+                ok = _mm256_and_pd(ok, _mm256_cmp_pd(magnitude, smallest, _CMP_GE_OQ));
+                ok = _mm256_and_pd(
+                    ok, _mm256_cmp_pd(o, _mm256_set1_pd(columns[axis][0]), _CMP_EQ_OQ));
+                signs[axis] |= _mm256_movemask_pd(d) << (4 * half);
+            }
+            const __m256d ray_t_min = _mm256_load_pd(columns[6] + 4 * half);
+            const __m256d ray_t_max = _mm256_load_pd(columns[7] + 4 * half);
+            // Valid (t_min <= t_max, false for NaN), and BoxRay's t_min the float itself (it is
+            // exact and finite) and not negative, so that the interval is not signed.
+            t_min_half[half] = _mm256_cvtpd_ps(ray_t_min);
+            const __m256d back = _mm256_cvtps_pd(t_min_half[half]);
+            ok = _mm256_and_pd(ok, _mm256_cmp_pd(ray_t_min, ray_t_max, _CMP_LE_OQ));
+            ok = _mm256_and_pd(ok, _mm256_cmp_pd(back, ray_t_min, _CMP_LE_OQ));
+            ok = _mm256_and_pd(ok, _mm256_cmp_pd(back, _mm256_set1_pd(kInfinity), _CMP_NEQ_OQ));
+            ok = _mm256_and_pd(ok, _mm256_cmp_pd(back, _mm256_setzero_pd(), _CMP_GE_OQ));
+            common &= static_cast<unsigned>(_mm256_movemask_pd(ok)) << (4 * half) |
+                      (half == 0 ? 0xf0u : 0x0fu);
+        }
+        if (common != 0xffu) return false;
+        bool negative[3];
+        float o_point[3], n_low[3], n_high[3], f_low[3], f_high[3];
+        const __m256 float_max = _mm256_set1_ps(std::numeric_limits<float>::max());
+        const __m256 float_sign = _mm256_set1_ps(-0.0f);
         for (int axis = 0; axis < 3; ++axis) {
-            const bool negative = first.negative[axis];
-            near_origin[axis] = _mm256_set1_ps(negative ? o_low[axis] : o_high[axis]);
-            far_origin[axis] = _mm256_set1_ps(negative ? o_high[axis] : o_low[axis]);
+            if (signs[axis] != 0 && signs[axis] != 0xff) return false;
+            negative[axis] = signs[axis] != 0;
+            const __m256 direction =
+                _mm256_set_m128(_mm256_cvtpd_ps(_mm256_load_pd(columns[3 + axis] + 4)),
+                                _mm256_cvtpd_ps(_mm256_load_pd(columns[3 + axis])));
+            const __m256 inverse = _mm256_div_ps(_mm256_set1_ps(1.0f), direction);
+            const __m256 near = _mm256_mul_ps(inverse, _mm256_set1_ps(1.0f - kSlack));
+            const __m256 far = _mm256_mul_ps(inverse, _mm256_set1_ps(1.0f + kSlack));
+            const __m256 finite = _mm256_and_ps(
+                _mm256_cmp_ps(_mm256_andnot_ps(float_sign, near), float_max, _CMP_LE_OQ),
+                _mm256_cmp_ps(_mm256_andnot_ps(float_sign, far), float_max, _CMP_LE_OQ));
+            if (_mm256_movemask_ps(finite) != 0xff) return false;
+            o_point[axis] = static_cast<float>(columns[axis][0]);
+            n_low[axis] = smallest_lane(near);
+            n_high[axis] = -smallest_lane(_mm256_xor_ps(near, float_sign));
+            f_low[axis] = smallest_lane(far);
+            f_high[axis] = -smallest_lane(_mm256_xor_ps(far, float_sign));
+        }
+        set(o_point, o_point, n_low, n_high, f_low, f_high, negative,
+            smallest_lane(_mm256_set_m128(t_min_half[1], t_min_half[0])));
+        return true;
+    }
+
+    /// The test of a packet whose origins span [o_low, o_high] and reciprocals [n_low,
+    /// n_high] and [f_low, f_high] on each axis, with one sign per axis (negative), and whose
+    /// least t_min is lowest_t_min.
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] void set(const float* o_low, const float* o_high,
+                                                    const float* n_low, const float* n_high,
+                                                    const float* f_low, const float* f_high,
+                                                    const bool* negative, float lowest_t_min) {
+        for (int axis = 0; axis < 3; ++axis) {
+            near_origin[axis] = _mm256_set1_ps(negative[axis] ? o_low[axis] : o_high[axis]);
+            far_origin[axis] = _mm256_set1_ps(negative[axis] ? o_high[axis] : o_low[axis]);
             near_low[axis] = _mm256_set1_ps(n_low[axis]);
             near_high[axis] = _mm256_set1_ps(n_high[axis]);
             far_low[axis] = _mm256_set1_ps(f_low[axis]);
             far_high[axis] = _mm256_set1_ps(f_high[axis]);
-            near_row[axis] = first.near_row(axis, 8);
-            far_row[axis] = first.far_row(axis, 8);
+            // BoxRay::near_row and far_row of a width-8 node.
+            near_row[axis] = (2 * axis + (negative[axis] ? 1 : 0)) * 8;
+            far_row[axis] = (2 * axis + (negative[axis] ? 0 : 1)) * 8;
         }
         t_min = _mm256_set1_ps(lowest_t_min);
-        return true;
+    }
+
+    /// The least of eight floats, none of them NaN.
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] static float smallest_lane(__m256 values) {
+        __m128 least = _mm_min_ps(_mm256_castps256_ps128(values), _mm256_extractf128_ps(values, 1));
+        least = _mm_min_ps(least, _mm_movehl_ps(least, least));
+        least = _mm_min_ss(least, _mm_shuffle_ps(least, least, 1));
+        return _mm_cvtss_f32(least);
     }
 
     /// As Avx2NodeTest::hit<false> for the whole packet; t_enter must be 32-byte aligned.
