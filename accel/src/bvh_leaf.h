@@ -247,6 +247,8 @@ struct alignas(32) Avx2BlockRay {
 /// with TriangleSet::hit_sheared on their own values.
 struct alignas(32) PacketTriangleRays {
     __m256 origin[3], shear_x, shear_y;
+    /// Each ray's 1 / d_z in double, rays 0-3 and 4-7 (set by accepts_rays only).
+    __m256d shear_z[2];
     std::ptrdiff_t axis[3];
 
     /// Whether the open rays' prepared rays share their axes; if so, sets the lanes up.
@@ -270,6 +272,74 @@ struct alignas(32) PacketTriangleRays {
         for (int a = 0; a < 3; ++a) origin[a] = _mm256_load_ps(values[a]);
         shear_x = _mm256_load_ps(values[3]);
         shear_y = _mm256_load_ps(values[4]);
+        return true;
+    }
+
+    /// accepts for a packet's rays (1 to 8) all open, with their prepared rays made here,
+    /// for packets that PacketIntervalTest::accepts_rays takes (finite rays, no zero direction
+    /// component): TriangleSet::prepare's operations lane by lane (the axes of max_dimension,
+    /// divpd, cvtpd2ps), so the same prepared rays, written to prepared[0, n). False, with
+    /// nothing made, when the rays do not share their axes.
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] bool accepts_rays(
+        const PacketRayColumns& packet, int n, TriangleSet<float>::PreparedRay* prepared) {
+        const auto& rows = packet.rows;
+        // max_dimension's choice, the first largest |d| in x, y, z order.
+        const __m256d sign = _mm256_set1_pd(-0.0);
+        unsigned on_x = 0, on_y = 0;
+        for (int half = 0; half < 2; ++half) {
+            const __m256d ax = _mm256_andnot_pd(sign, _mm256_load_pd(rows[3] + 4 * half));
+            const __m256d ay = _mm256_andnot_pd(sign, _mm256_load_pd(rows[4] + 4 * half));
+            const __m256d az = _mm256_andnot_pd(sign, _mm256_load_pd(rows[5] + 4 * half));
+            const __m256d x_over_y = _mm256_cmp_pd(ax, ay, _CMP_GE_OQ);
+            const __m256d x = _mm256_and_pd(x_over_y, _mm256_cmp_pd(ax, az, _CMP_GE_OQ));
+            const __m256d y = _mm256_andnot_pd(x_over_y, _mm256_cmp_pd(ay, az, _CMP_GE_OQ));
+            on_x |= static_cast<unsigned>(_mm256_movemask_pd(x)) << (4 * half);
+            on_y |= static_cast<unsigned>(_mm256_movemask_pd(y)) << (4 * half);
+        }
+        int axis_z;
+        if (on_x == 0xffu) {
+            axis_z = 0;
+        } else if (on_y == 0xffu) {
+            axis_z = 1;
+        } else if ((on_x | on_y) == 0) {
+            axis_z = 2;
+        } else {
+            return false;
+        }
+        axis[2] = axis_z;
+        axis[0] = axis_z == 2 ? 0 : axis_z + 1;
+        axis[1] = axis[0] == 2 ? 0 : axis[0] + 1;
+        alignas(32) float origin_lanes[3][8], shear_lanes[2][8];
+        alignas(32) double scale[8];
+        for (int half = 0; half < 2; ++half) {
+            const __m256d dz = _mm256_load_pd(rows[3 + axis[2]] + 4 * half);
+            const __m256d inverse = _mm256_div_pd(_mm256_set1_pd(1.0), dz);
+            _mm256_store_pd(scale + 4 * half, inverse);
+            shear_z[half] = inverse;
+            for (int a = 0; a < 2; ++a) {
+                const __m256d ratio =
+                    _mm256_div_pd(_mm256_load_pd(rows[3 + axis[a]] + 4 * half), dz);
+                _mm_store_ps(shear_lanes[a] + 4 * half, _mm256_cvtpd_ps(ratio));
+            }
+            for (int k = 0; k < 3; ++k)
+                _mm_store_ps(origin_lanes[k] + 4 * half,
+                             _mm256_cvtpd_ps(_mm256_load_pd(rows[k] + 4 * half)));
+        }
+        for (int a = 0; a < 3; ++a) origin[a] = _mm256_load_ps(origin_lanes[axis[a]]);
+        shear_x = _mm256_load_ps(shear_lanes[0]);
+        shear_y = _mm256_load_ps(shear_lanes[1]);
+        for (int r = 0; r < n; ++r) {
+            TriangleSet<float>::PreparedRay& ray = prepared[r];
+            for (int k = 0; k < 3; ++k) ray.origin[k] = origin_lanes[k][r];
+            ray.axis_x = static_cast<int>(axis[0]);
+            ray.axis_y = static_cast<int>(axis[1]);
+            ray.axis_z = axis_z;
+            ray.shear_x = shear_lanes[0][r];
+            ray.shear_y = shear_lanes[1][r];
+            ray.shear_z = scale[r];
+            ray.t_min = rows[6][r];
+            ray.t_max = rows[7][r];
+        }
         return true;
     }
 

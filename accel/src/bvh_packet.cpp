@@ -123,7 +123,8 @@ struct BvhTraversal<Set>::Packets {
             // The common camera packet (every ray valid, one origin), set up for all its rays
             // at once; others below, ray by ray.
             PacketIntervalTest interval;
-            if (interval.accepts_rays(rays.data(), n)) {
+            const PacketRayColumns columns(rays.data(), n);
+            if (interval.accepts_rays(columns)) {
                 for (int r = 0; r < n; ++r) {
                     lanes.t_max[r] = round_up(rays[r].t_max);
                     best[r] = HitRecord{};
@@ -131,7 +132,7 @@ struct BvhTraversal<Set>::Packets {
                 }
                 open = (1u << n) - 1u;
                 return walk_interval_packet<kAny>(bvh, rays, lanes, open, interval, best, found,
-                                                  scratch);
+                                                  scratch, &columns);
             }
         }
 #endif
@@ -148,7 +149,7 @@ struct BvhTraversal<Set>::Packets {
             PacketIntervalTest interval;
             if (interval.accepts(lanes, open)) {
                 return walk_interval_packet<kAny>(bvh, rays, lanes, open, interval, best, found,
-                                                  scratch);
+                                                  scratch, nullptr);
             }
             // Rays without a common origin (shadow rays from a surface, incoherent rays): the
             // packet's interval would hold the region between their origins, where each of
@@ -241,12 +242,14 @@ struct BvhTraversal<Set>::Packets {
     /// The nearest hits (or occlusion) of a packet whose rays PacketIntervalTest accepts: the
     /// tree is walked once with the packet's conservative node test, as one ray would walk it,
     /// and every leaf it reaches is tested for each open ray with that ray's own leaf test and
-    /// t_max. The upper bound of the walk is the largest t_max of the open rays.
+    /// t_max. The upper bound of the walk is the largest t_max of the open rays. `columns`:
+    /// the rays as PacketRayColumns when every one is open (PacketIntervalTest::accepts_rays'
+    /// packets), else null.
     template <bool kAny>
     [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] static void walk_interval_packet(
         const Tree& bvh, std::span<const Ray> rays, PacketLanes<Avx2NodeTest>& lanes,
         std::uint32_t open, const PacketIntervalTest& test, HitRecord* best, bool* found,
-        QueryScratch& scratch) {
+        QueryScratch& scratch, const PacketRayColumns* columns) {
         TraversalCounters unused;
         auto largest_t_max = [&] {
             float t_max = -kFloatInfinity;
@@ -258,12 +261,20 @@ struct BvhTraversal<Set>::Packets {
             if (!bvh.leaf_triangles_.empty()) {
                 // Ray-parallel leaves, when the rays share the triangle test's axes.
                 typename Set::PreparedRay prepared[Tree::kPacketRays];
-                for (std::uint32_t m = open; m != 0; m &= m - 1) {
-                    const int r = std::countr_zero(m);
-                    prepared[r] = bvh.set_->prepare(rays[r], scratch);
-                }
                 PacketTriangleRays triangle_rays;
-                if (triangle_rays.accepts(prepared, open)) {
+                // All the rays open (accepts_rays' packets): their prepared rays eight at a
+                // time; else ray by ray.
+                auto accepted = [&] {
+                    if (columns != nullptr)
+                        return triangle_rays.accepts_rays(*columns, static_cast<int>(rays.size()),
+                                                          prepared);
+                    for (std::uint32_t m = open; m != 0; m &= m - 1) {
+                        const int r = std::countr_zero(m);
+                        prepared[r] = bvh.set_->prepare(rays[r], scratch);
+                    }
+                    return triangle_rays.accepts(prepared, open);
+                };
+                if (accepted()) {
                     // The triangle of lane `lane` of the group of kWidth lanes at `group`
                     // against every open ray, for rays whose test axis z is kAxisZ.
                     auto test_lane = [&]<int kAxisZ, std::ptrdiff_t kWidth>(const float* group,

@@ -454,6 +454,28 @@ struct alignas(32) Avx2FusedNodeTest {
 #endif
 
 #if CSGRT_BVH_AVX2
+/// Up to eight rays as columns: row k of column r is ray r's origin (k = 0-2), direction
+/// (3-5), t_min (6) and t_max (7). Columns past the packet's size repeat ray 0, which changes
+/// no minimum, maximum or common value the packet tests take of them.
+struct PacketRayColumns {
+    alignas(32) double rows[8][8];
+
+    PacketRayColumns(const Ray* rays, int n) {
+        for (int r = 0; r < 8; ++r) {
+            const Ray& ray = rays[r < n ? r : 0];
+            for (int k = 0; k < 3; ++k) {
+                rows[k][r] = ray.origin[k];
+                rows[3 + k][r] = ray.direction[k];
+            }
+            rows[6][r] = ray.t_min;
+            rows[7][r] = ray.t_max;
+        }
+    }
+};
+
+#endif
+
+#if CSGRT_BVH_AVX2
 /// The node test of a packet of rays whose directions share their signs, taken as intervals
 /// (interval arithmetic culling: Wald, Boulos and Shirley, "Ray Tracing Deformable Scenes
 /// Using Dynamic Bounding Volume Hierarchies", ACM TOG 2007). On each axis the rays' origins
@@ -517,25 +539,14 @@ struct alignas(32) PacketIntervalTest {
         return true;
     }
 
-    /// accepts for rays[0, n) (1 <= n <= 8) all open, in the common case only: every ray
+    /// accepts for a packet's rays (1 to 8) all open, in the common case only: every ray
     /// representable and valid (as BoxRay finds them), t_min a float >= 0, no zero direction
     /// component, one origin, one sign per axis, finite reciprocals. The rays' BoxRay values
     /// are made eight at a time with BoxRay's own float operations lane by lane (cvtpd2ps,
     /// divps, mulps), so the test is the very one accepts would make from the rays' BoxRays.
     /// False, with nothing set, for any other packet: accepts then decides from BoxRays.
-    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] bool accepts_rays(const Ray* rays, int n) {
-        // Ray r's origin, direction, t_min and t_max in column r; columns past n repeat ray 0,
-        // which changes no minimum, maximum or test below.
-        alignas(32) double columns[8][8];
-        for (int r = 0; r < 8; ++r) {
-            const Ray& ray = rays[r < n ? r : 0];
-            for (int k = 0; k < 3; ++k) {
-                columns[k][r] = ray.origin[k];
-                columns[3 + k][r] = ray.direction[k];
-            }
-            columns[6][r] = ray.t_min;
-            columns[7][r] = ray.t_max;
-        }
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] bool accepts_rays(const PacketRayColumns& packet) {
+        const auto& columns = packet.rows;
         const __m256d sign = _mm256_set1_pd(-0.0);
         const __m256d largest = _mm256_set1_pd(kLargestBoxRayValue);
         const __m256d smallest = _mm256_set1_pd(1.0 / kLargestBoxRayValue);
@@ -550,12 +561,12 @@ struct alignas(32) PacketIntervalTest {
                 const __m256d magnitude = _mm256_andnot_pd(sign, d);
                 // BoxRay's representability without its zero case (false for NaN), and one
                 // origin, compared in double.
-                ok = _mm256_and_pd(ok, _mm256_cmp_pd(_mm256_andnot_pd(sign, o), largest,
-                                                     _CMP_LE_OQ));
+                ok = _mm256_and_pd(ok,
+                                   _mm256_cmp_pd(_mm256_andnot_pd(sign, o), largest, _CMP_LE_OQ));
                 ok = _mm256_and_pd(ok, _mm256_cmp_pd(magnitude, largest, _CMP_LE_OQ));
                 ok = _mm256_and_pd(ok, _mm256_cmp_pd(magnitude, smallest, _CMP_GE_OQ));
-                ok = _mm256_and_pd(
-                    ok, _mm256_cmp_pd(o, _mm256_set1_pd(columns[axis][0]), _CMP_EQ_OQ));
+                ok = _mm256_and_pd(ok,
+                                   _mm256_cmp_pd(o, _mm256_set1_pd(columns[axis][0]), _CMP_EQ_OQ));
                 signs[axis] |= _mm256_movemask_pd(d) << (4 * half);
             }
             const __m256d ray_t_min = _mm256_load_pd(columns[6] + 4 * half);

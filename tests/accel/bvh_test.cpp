@@ -278,16 +278,27 @@ TYPED_TEST(BvhMeshTest, PacketsGiveTheSingleRayAnswersBitForBit) {
             // axis: the packets take the ray-parallel leaf test.
             for (int j = 1; j <= 8; ++j) {
                 for (int i = 1; i <= 8; ++i) {
-                    for (const Vector3& offset : {Vector3(0.0, 0.0, 0.0), Vector3(0.5, 0.0, 0.0),
-                                                 Vector3(0.5, 0.5, 0.0)}) {
+                    for (const Vector3& offset :
+                         {Vector3(0.0, 0.0, 0.0), Vector3(0.5, 0.0, 0.0), Vector3(0.5, 0.5, 0.0)}) {
                         Ray ray;
                         ray.origin = Point3(0.5, 0.5, -8.0);
                         ray.direction = Point3(i, j, 0.0) + offset - ray.origin;
-                        if (ray.direction.x() < 8.0 && ray.direction.y() < 8.0)
-                            rays.push_back(ray);
+                        if (ray.direction.x() < 8.0 && ray.direction.y() < 8.0) rays.push_back(ray);
                     }
                 }
             }
+        }
+        // One origin's rays whose largest direction component changes from one to the next
+        // (the triangle test's axes differ within a packet), ties included; eight from a
+        // multiple of eight, so they make packets of their own.
+        while (rays.size() % 8 != 0) rays.push_back(rays.front());
+        for (int k = 0; k < 64; ++k) {
+            Ray ray;
+            ray.origin = box.lower - 0.5 * box.diagonal();
+            const double step = 0.25 * (k % 8 - 4) / 4.0;
+            ray.direction =
+                k % 16 < 8 ? Vector3(1.0, 1.0 + step, 0.9) : Vector3(1.0, 0.9, 1.0 + step);
+            rays.push_back(ray);
         }
         const std::vector<Ray> mixed = mixed_rays(box, test::scaled(3001), 77);
         rays.insert(rays.end(), mixed.begin(), mixed.end());
