@@ -160,10 +160,22 @@ struct Avx2ShearedLanes {
     [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] Avx2ShearedLanes(const __m256 (&corners)[3][3],
                                                             const __m256 (&origin)[3],
                                                             __m256 shear_x, __m256 shear_y) {
+        __m256 relative[3][3];
         for (int k = 0; k < 3; ++k) {
-            const __m256 px = _mm256_sub_ps(corners[k][0], origin[0]);
-            const __m256 py = _mm256_sub_ps(corners[k][1], origin[1]);
-            const __m256 pz = _mm256_sub_ps(corners[k][2], origin[2]);
+            for (int a = 0; a < 3; ++a) relative[k][a] = _mm256_sub_ps(corners[k][a], origin[a]);
+        }
+        shear(relative, shear_x, shear_y);
+    }
+    /// From the corners relative to the origin already (corner - origin in float, as above).
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] Avx2ShearedLanes(const __m256 (&relative)[3][3],
+                                                            __m256 shear_x, __m256 shear_y) {
+        shear(relative, shear_x, shear_y);
+    }
+
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] void shear(const __m256 (&relative)[3][3],
+                                                      __m256 shear_x, __m256 shear_y) {
+        for (int k = 0; k < 3; ++k) {
+            const __m256 px = relative[k][0], py = relative[k][1], pz = relative[k][2];
             x[k] = _mm256_sub_ps(px, _mm256_mul_ps(shear_x, pz));
             y[k] = _mm256_sub_ps(py, _mm256_mul_ps(shear_y, pz));
             z[k] = pz;
@@ -250,6 +262,8 @@ struct alignas(32) PacketTriangleRays {
     /// Each ray's 1 / d_z in double, rays 0-3 and 4-7 (set by accepts_rays only).
     __m256d shear_z[2];
     std::ptrdiff_t axis[3];
+    /// The rays' common origin in float, on the axes x, y, z.
+    float origin_point[3];
 
     /// Whether the open rays' prepared rays share their axes; if so, sets the lanes up.
     [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] bool accepts(
@@ -270,6 +284,7 @@ struct alignas(32) PacketTriangleRays {
         axis[1] = first.axis_y;
         axis[2] = first.axis_z;
         for (int a = 0; a < 3; ++a) origin[a] = _mm256_load_ps(values[a]);
+        for (int k = 0; k < 3; ++k) origin_point[k] = first.origin[k];
         shear_x = _mm256_load_ps(values[3]);
         shear_y = _mm256_load_ps(values[4]);
         return true;
@@ -326,6 +341,7 @@ struct alignas(32) PacketTriangleRays {
                              _mm256_cvtpd_ps(_mm256_load_pd(rows[k] + 4 * half)));
         }
         for (int a = 0; a < 3; ++a) origin[a] = _mm256_load_ps(origin_lanes[axis[a]]);
+        for (int k = 0; k < 3; ++k) origin_point[k] = origin_lanes[k][0];
         shear_x = _mm256_load_ps(shear_lanes[0]);
         shear_y = _mm256_load_ps(shear_lanes[1]);
         for (int r = 0; r < n; ++r) {
@@ -343,20 +359,40 @@ struct alignas(32) PacketTriangleRays {
         return true;
     }
 
-    /// The rays (bits of `rays`) for which the triangle of lane `lane` of the group of kWidth
-    /// lanes at `group` (BvhLeafTriangles) may be hit; where there are some, `sheared` holds
-    /// every ray's sheared corners (x, y, z of corners 0, 1, 2).
-    template <int kAxisZ, std::ptrdiff_t kWidth>
-    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] unsigned candidates(const float* group,
+    /// The corners of a group of kWidth lanes at `group` (BvhLeafTriangles; 4 or 8 lanes,
+    /// aligned to their width) relative to the packet's origin, one subtraction for the whole
+    /// group where each triangle against each ray would take one: relative[3 k + a][lane] is
+    /// corner k's on axis a, fl(corner - origin) as Avx2ShearedLanes forms it. The rays of
+    /// every packet PacketIntervalTest accepts share their origin.
+    template <std::ptrdiff_t kWidth>
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] void relative_corners(
+        const float* group, float (&relative)[9][8]) const {
+        for (int row = 0; row < 9; ++row) {
+            const float o = origin_point[row % 3];
+            if constexpr (kWidth == 8) {
+                _mm256_store_ps(relative[row], _mm256_sub_ps(_mm256_load_ps(group + 8 * row),
+                                                             _mm256_set1_ps(o)));
+            } else {
+                static_assert(kWidth == 4);
+                _mm_store_ps(relative[row],
+                             _mm_sub_ps(_mm_load_ps(group + 4 * row), _mm_set1_ps(o)));
+            }
+        }
+    }
+
+    /// The rays (bits of `rays`) for which the triangle of lane `lane` of a group whose corners
+    /// relative_corners gave may be hit; where there are some, `sheared` holds every ray's
+    /// sheared corners (x, y, z of corners 0, 1, 2).
+    template <int kAxisZ>
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] unsigned candidates(const float (&relative)[9][8],
                                                                std::ptrdiff_t lane, unsigned rays,
                                                                float (&sheared)[9][8]) const {
         __m256 corners[3][3];
-        const float* column = group + lane;
         for (int k = 0; k < 3; ++k) {
             for (int a = 0; a < 3; ++a)
-                corners[k][a] = _mm256_set1_ps(column[(3 * k + test_axis<kAxisZ>(a)) * kWidth]);
+                corners[k][a] = _mm256_set1_ps(relative[3 * k + test_axis<kAxisZ>(a)][lane]);
         }
-        const Avx2ShearedLanes lanes(corners, origin, shear_x, shear_y);
+        const Avx2ShearedLanes lanes(corners, shear_x, shear_y);
         const unsigned result = lanes.candidates() & rays;
         if (result != 0) {
             for (int k = 0; k < 3; ++k) {

@@ -277,11 +277,12 @@ struct BvhTraversal<Set>::Packets {
                 if (accepted()) {
                     // The triangle of lane `lane` of the group of kWidth lanes at `group`
                     // against every open ray, for rays whose test axis z is kAxisZ.
-                    auto test_lane = [&]<int kAxisZ, std::ptrdiff_t kWidth>(const float* group,
-                                                                            std::ptrdiff_t lane) {
+                    auto test_lane = [&]<int kAxisZ, std::ptrdiff_t kWidth>(
+                                         const float* group, const float(&relative)[9][8],
+                                         std::ptrdiff_t lane) {
                         alignas(32) float sheared[9][8];
-                        unsigned candidates = triangle_rays.template candidates<kAxisZ, kWidth>(
-                            group, lane, open, sheared);
+                        unsigned candidates = triangle_rays.template candidates<kAxisZ>(
+                            relative, lane, open, sheared);
                         while (candidates != 0) {
                             const int r = std::countr_zero(candidates);
                             candidates &= candidates - 1;
@@ -318,13 +319,21 @@ struct BvhTraversal<Set>::Packets {
                         for (; left > kBlockLanes; group += 2 * kBlockLanes * kLaneFloats) {
                             const std::uint32_t used = std::min(left, 2 * kBlockLanes);
                             left -= used;
+                            alignas(32) float relative[9][8];
+                            triangle_rays.template relative_corners<2 * kBlockLanes>(group,
+                                                                                     relative);
                             for (std::uint32_t lane = 0; lane < used; ++lane) {
-                                test_lane.template operator()<kAxisZ, 2 * kBlockLanes>(group, lane);
+                                test_lane.template operator()<kAxisZ, 2 * kBlockLanes>(
+                                    group, relative, lane);
                                 if (open == 0) return true;
                             }
                         }
+                        if (left == 0) return false;
+                        alignas(32) float relative[9][8];
+                        triangle_rays.template relative_corners<kBlockLanes>(group, relative);
                         for (std::uint32_t lane = 0; lane < left; ++lane) {
-                            test_lane.template operator()<kAxisZ, kBlockLanes>(group, lane);
+                            test_lane.template operator()<kAxisZ, kBlockLanes>(group, relative,
+                                                                               lane);
                             if (open == 0) return true;
                         }
                         return false;
