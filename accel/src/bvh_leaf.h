@@ -365,13 +365,13 @@ struct alignas(32) PacketTriangleRays {
     /// corner k's on axis a, fl(corner - origin) as Avx2ShearedLanes forms it. The rays of
     /// every packet PacketIntervalTest accepts share their origin.
     template <std::ptrdiff_t kWidth>
-    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] void relative_corners(
-        const float* group, float (&relative)[9][8]) const {
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] void relative_corners(const float* group,
+                                                                 float (&relative)[9][8]) const {
         for (int row = 0; row < 9; ++row) {
             const float o = origin_point[row % 3];
             if constexpr (kWidth == 8) {
-                _mm256_store_ps(relative[row], _mm256_sub_ps(_mm256_load_ps(group + 8 * row),
-                                                             _mm256_set1_ps(o)));
+                _mm256_store_ps(relative[row],
+                                _mm256_sub_ps(_mm256_load_ps(group + 8 * row), _mm256_set1_ps(o)));
             } else {
                 static_assert(kWidth == 4);
                 _mm_store_ps(relative[row],
