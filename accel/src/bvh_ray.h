@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include "bvh_simd.h"
 #include "csgrt/accel/bvh.h"
@@ -460,15 +461,32 @@ struct alignas(32) Avx2FusedNodeTest {
 struct PacketRayColumns {
     alignas(32) double rows[8][8];
 
-    PacketRayColumns(const Ray* rays, int n) {
-        for (int r = 0; r < 8; ++r) {
-            const Ray& ray = rays[r < n ? r : 0];
-            for (int k = 0; k < 3; ++k) {
-                rows[k][r] = ray.origin[k];
-                rows[3 + k][r] = ray.direction[k];
+    // A Ray is these eight doubles in this order, so four rays are two 4x4 transposes.
+    static_assert(std::is_standard_layout_v<Ray> && sizeof(Ray) == 8 * sizeof(double) &&
+                  offsetof(Ray, direction) == 3 * sizeof(double) &&
+                  offsetof(Ray, t_min) == 6 * sizeof(double) &&
+                  offsetof(Ray, t_max) == 7 * sizeof(double));
+
+    [[gnu::target(CSGRT_BVH_AVX2_TARGET)]] PacketRayColumns(const Ray* rays, int n) {
+        for (int block = 0; block < 2; ++block) {
+            const double* ray[4];
+            for (int k = 0; k < 4; ++k) {
+                const int r = 4 * block + k;
+                ray[k] = reinterpret_cast<const double*>(&rays[r < n ? r : 0]);
             }
-            rows[6][r] = ray.t_min;
-            rows[7][r] = ray.t_max;
+            for (int half = 0; half < 2; ++half) {
+                const __m256d a = _mm256_loadu_pd(ray[0] + 4 * half);
+                const __m256d b = _mm256_loadu_pd(ray[1] + 4 * half);
+                const __m256d c = _mm256_loadu_pd(ray[2] + 4 * half);
+                const __m256d d = _mm256_loadu_pd(ray[3] + 4 * half);
+                const __m256d ab_even = _mm256_unpacklo_pd(a, b), ab_odd = _mm256_unpackhi_pd(a, b);
+                const __m256d cd_even = _mm256_unpacklo_pd(c, d), cd_odd = _mm256_unpackhi_pd(c, d);
+                double* row = rows[4 * half] + 4 * block;
+                _mm256_store_pd(row, _mm256_permute2f128_pd(ab_even, cd_even, 0x20));
+                _mm256_store_pd(row + 8, _mm256_permute2f128_pd(ab_odd, cd_odd, 0x20));
+                _mm256_store_pd(row + 16, _mm256_permute2f128_pd(ab_even, cd_even, 0x31));
+                _mm256_store_pd(row + 24, _mm256_permute2f128_pd(ab_odd, cd_odd, 0x31));
+            }
         }
     }
 };
