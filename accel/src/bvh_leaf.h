@@ -259,8 +259,6 @@ struct alignas(32) Avx2BlockRay {
 /// with TriangleSet::hit_sheared on their own values.
 struct alignas(32) PacketTriangleRays {
     __m256 origin[3], shear_x, shear_y;
-    /// Each ray's 1 / d_z in double, rays 0-3 and 4-7 (set by accepts_rays only).
-    __m256d shear_z[2];
     std::ptrdiff_t axis[3];
     /// The rays' common origin in float, on the axes x, y, z.
     float origin_point[3];
@@ -330,7 +328,6 @@ struct alignas(32) PacketTriangleRays {
             const __m256d dz = _mm256_load_pd(rows[3 + axis[2]] + 4 * half);
             const __m256d inverse = _mm256_div_pd(_mm256_set1_pd(1.0), dz);
             _mm256_store_pd(scale + 4 * half, inverse);
-            shear_z[half] = inverse;
             for (int a = 0; a < 2; ++a) {
                 const __m256d ratio =
                     _mm256_div_pd(_mm256_load_pd(rows[3 + axis[a]] + 4 * half), dz);
